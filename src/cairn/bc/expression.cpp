@@ -1,0 +1,68 @@
+#include "cairn/bc/expression.hpp"
+
+#include <muParser.h>
+
+#include <stdexcept>
+
+namespace cairn {
+
+Expression::Expression(const std::string& text, const Constants& constants)
+    : text_(text), parser_(std::make_unique<mu::Parser>()) {
+  try {
+    parser_->DefineVar("x", &x_);
+    parser_->DefineVar("y", &y_);
+    parser_->DefineVar("z", &z_);
+    parser_->DefineVar("X", &X_);
+    parser_->DefineVar("Y", &Y_);
+    parser_->DefineVar("Z", &Z_);
+    parser_->DefineVar("t", &t_);
+    parser_->DefineConst("pi", 3.141592653589793238462643383279502884);
+    for (const auto& [name, value] : constants) parser_->DefineConst(name, value);
+    parser_->SetExpr(text);
+    const auto used = parser_->GetUsedVar();  // also checks the syntax
+    constant_ = used.empty();
+    uses_x_ = used.count("x") || used.count("y") || used.count("z");
+    parser_->Eval();
+  } catch (const mu::Parser::exception_type& e) {
+    throw std::invalid_argument("expression \"" + text + "\": " + e.GetMsg());
+  }
+}
+
+Expression::~Expression() = default;
+
+double Expression::operator()(const Vec3& x, const Vec3& X, double t) {
+  x_ = x[0];
+  y_ = x[1];
+  z_ = x[2];
+  X_ = X[0];
+  Y_ = X[1];
+  Z_ = X[2];
+  t_ = t;
+  return parser_->Eval();
+}
+
+template <int D>
+ExpressionVector<D>::ExpressionVector(const std::vector<std::string>& texts, const Constants& constants) {
+  for (const auto& t : texts) parts_.push_back(std::make_unique<Expression>(t, constants));
+}
+
+template <int D>
+bool ExpressionVector<D>::is_constant() const {
+  for (const auto& p : parts_)
+    if (!p->is_constant()) return false;
+  return true;
+}
+
+template <int D>
+Vec<D> ExpressionVector<D>::operator()(const Vec<D>& x, const Vec<D>& X, double t) {
+  Vec<D> out = Vec<D>::Zero();
+  const Vec3 x3 = to3<D>(x), X3 = to3<D>(X);
+  for (int a = 0; a < D && a < static_cast<int>(parts_.size()); ++a) out[a] = (*parts_[a])(x3, X3, t);
+  return out;
+}
+
+template class ExpressionVector<1>;
+template class ExpressionVector<2>;
+template class ExpressionVector<3>;
+
+}  // namespace cairn

@@ -1,0 +1,265 @@
+#include "cairn/io/checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+#include <system_error>
+
+#include "cairn/io/atomic_file.hpp"
+#include "cairn/io/hdf5_util.hpp"
+
+namespace cairn {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* format_name = "cairn-checkpoint";
+
+template <int D>
+void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v) {
+  std::vector<double> buffer(D * v.size());
+  for (std::size_t p = 0; p < v.size(); ++p)
+    for (int a = 0; a < D; ++a) buffer[D * p + a] = v[p][a];
+  h5::write_doubles(loc, name, buffer.data(), v.size(), D);
+}
+
+template <int D>
+std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t n) {
+  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, static_cast<std::size_t>(D)});
+  std::vector<Vec<D>> v(n);
+  for (std::size_t p = 0; p < n; ++p)
+    for (int a = 0; a < D; ++a) v[p][a] = buffer[D * p + a];
+  return v;
+}
+
+void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m) {
+  std::vector<double> buffer(9 * m.size());
+  for (std::size_t p = 0; p < m.size(); ++p)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) buffer[9 * p + 3 * i + j] = m[p](i, j);
+  h5::write_doubles(loc, name, buffer.data(), m.size(), 9);
+}
+
+std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
+  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, 9});
+  std::vector<Mat3> m(n);
+  for (std::size_t p = 0; p < n; ++p)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m[p](i, j) = buffer[9 * p + 3 * i + j];
+  return m;
+}
+
+template <int D>
+void check_particles(const Particles<D>& ps) {
+  const std::size_t n = ps.n();
+  const bool ok = ps.reference_position.size() == n && ps.velocity.size() == n &&
+                  ps.mass.size() == n && ps.volume0.size() == n && ps.size0.size() == n &&
+                  ps.deformation_gradient.size() == n && ps.kirchhoff_stress.size() == n &&
+                  ps.velocity_gradient.size() == n && ps.material.size() == n &&
+                  ps.body.size() == n && ps.n_state_per_particle >= 0 &&
+                  ps.state.size() == n * static_cast<std::size_t>(ps.n_state_per_particle);
+  if (!ok) throw std::invalid_argument("write_checkpoint: particle arrays have inconsistent lengths");
+}
+
+/// Open `path` and check that it is a Cairn checkpoint of the supported version; returns the
+/// open file and stores its dimension.
+h5::Handle open_checkpoint(const fs::path& path, int& dimension) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    throw std::runtime_error("checkpoint file '" + path.string() + "' does not exist");
+  }
+  h5::Handle file;
+  try {
+    file = h5::open_file(path);
+  } catch (const std::runtime_error&) {
+    throw std::runtime_error("'" + path.string() + "' is not a Cairn checkpoint (not an HDF5 file)");
+  }
+  const hid_t root = file.get();
+  if (!h5::has_attribute(root, "format")) {
+    throw std::runtime_error("'" + path.string() +
+                             "' is not a Cairn checkpoint (HDF5 file without a 'format' attribute)");
+  }
+  std::string format;
+  try {
+    format = h5::read_string_attribute(root, "format");
+  } catch (const std::runtime_error&) {
+    format = "?";
+  }
+  if (format != format_name) {
+    throw std::runtime_error("'" + path.string() + "' is not a Cairn checkpoint (its format is '" +
+                             format + "', expected '" + format_name + "')");
+  }
+  const long long version = h5::read_int64_attribute(root, "version");
+  if (version != checkpoint_format_version) {
+    throw std::runtime_error(fmt::format(
+        "checkpoint '{}' has format version {}, but this build of Cairn reads only version {}",
+        path.string(), version, checkpoint_format_version));
+  }
+  const long long dim = h5::read_int64_attribute(root, "dimension");
+  if (dim < 1 || dim > 3) {
+    throw std::runtime_error(fmt::format("checkpoint '{}' has invalid dimension {}", path.string(), dim));
+  }
+  dimension = static_cast<int>(dim);
+  return file;
+}
+
+}  // namespace
+
+template <int D>
+void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
+  check_particles(data.particles);
+  const std::size_t n_rows = data.history_rows.size();
+  const std::size_t n_cols = n_rows > 0 ? data.history_rows.front().size() : data.history_columns.size();
+  for (const auto& row : data.history_rows) {
+    if (row.size() != n_cols) {
+      throw std::invalid_argument("write_checkpoint: history rows have different lengths");
+    }
+  }
+  write_file_atomically(path, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp);
+    const hid_t root = file.get();
+    h5::write_string_attribute(root, "format", format_name);
+    h5::write_int64_attribute(root, "version", checkpoint_format_version);
+    h5::write_int64_attribute(root, "dimension", D);
+    h5::write_double_attribute(root, "time", data.time);
+    h5::write_int64_attribute(root, "step", data.step);
+    h5::write_double_attribute(root, "previous_dt", data.previous_dt);
+    h5::write_int64_attribute(root, "snapshot_next_index", data.snapshot_next_index);
+    h5::write_text(root, "config_toml", data.config_toml);
+    {
+      h5::Handle g = h5::create_group(root, "scalars");
+      std::vector<std::string> names;
+      std::vector<double> values;
+      for (const auto& [name, value] : data.scalars) {
+        names.push_back(name);
+        values.push_back(value);
+      }
+      h5::write_text_list(g.get(), "names", names);
+      h5::write_doubles(g.get(), "values", values.data(), values.size());
+    }
+    {
+      h5::Handle g = h5::create_group(root, "history");
+      h5::write_text_list(g.get(), "columns", data.history_columns);
+      std::vector<double> rows;
+      rows.reserve(n_rows * n_cols);
+      for (const auto& row : data.history_rows) rows.insert(rows.end(), row.begin(), row.end());
+      h5::write_doubles_shaped(g.get(), "rows", rows.data(), {n_rows, n_cols});
+    }
+    {
+      h5::Handle g = h5::create_group(root, "snapshots");
+      std::vector<double> times;
+      std::vector<std::string> files;
+      for (const auto& [t, f] : data.snapshot_entries) {
+        times.push_back(t);
+        files.push_back(f);
+      }
+      h5::write_doubles(g.get(), "times", times.data(), times.size());
+      h5::write_text_list(g.get(), "files", files);
+    }
+    {
+      const Particles<D>& ps = data.particles;
+      const std::size_t n = ps.n();
+      h5::Handle g = h5::create_group(root, "particles");
+      const hid_t gid = g.get();
+      h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);
+      write_vecs<D>(gid, "position", ps.position);
+      write_vecs<D>(gid, "reference_position", ps.reference_position);
+      write_vecs<D>(gid, "velocity", ps.velocity);
+      h5::write_doubles(gid, "mass", ps.mass.data(), n);
+      h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
+      write_vecs<D>(gid, "size0", ps.size0);
+      write_mats(gid, "deformation_gradient", ps.deformation_gradient);
+      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
+      write_mats(gid, "velocity_gradient", ps.velocity_gradient);
+      h5::write_ints(gid, "material", ps.material.data(), n);
+      h5::write_ints(gid, "body", ps.body.data(), n);
+      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size());
+    }
+  });
+}
+
+template <int D>
+CheckpointData<D> read_checkpoint(const fs::path& path) {
+  int dimension = 0;
+  h5::Handle file = open_checkpoint(path, dimension);
+  if (dimension != D) {
+    throw std::runtime_error(fmt::format("checkpoint '{}' is from a {}D simulation, not {}D",
+                                         path.string(), dimension, D));
+  }
+  const hid_t root = file.get();
+  CheckpointData<D> data;
+  data.time = h5::read_double_attribute(root, "time");
+  data.step = h5::read_int64_attribute(root, "step");
+  data.previous_dt = h5::read_double_attribute(root, "previous_dt");
+  data.snapshot_next_index = static_cast<int>(h5::read_int64_attribute(root, "snapshot_next_index"));
+  data.config_toml = h5::read_text(root, "config_toml");
+  {
+    h5::Handle g = h5::open_group(root, "scalars");
+    const std::vector<std::string> names = h5::read_text_list(g.get(), "names");
+    const std::vector<double> values = h5::read_doubles(g.get(), "values", {names.size()});
+    for (std::size_t i = 0; i < names.size(); ++i) data.scalars[names[i]] = values[i];
+  }
+  {
+    h5::Handle g = h5::open_group(root, "history");
+    data.history_columns = h5::read_text_list(g.get(), "columns");
+    const std::vector<std::size_t> shape = h5::dataset_shape(g.get(), "rows");
+    if (shape.size() != 2) {
+      throw std::runtime_error("checkpoint '" + path.string() + "': /history/rows is not 2D");
+    }
+    const std::vector<double> rows = h5::read_doubles(g.get(), "rows", shape);
+    for (std::size_t r = 0; r < shape[0]; ++r) {
+      const auto first = rows.begin() + static_cast<std::ptrdiff_t>(r * shape[1]);
+      data.history_rows.emplace_back(first, first + static_cast<std::ptrdiff_t>(shape[1]));
+    }
+  }
+  {
+    h5::Handle g = h5::open_group(root, "snapshots");
+    const std::vector<std::string> files = h5::read_text_list(g.get(), "files");
+    const std::vector<double> times = h5::read_doubles(g.get(), "times", {files.size()});
+    for (std::size_t i = 0; i < files.size(); ++i) data.snapshot_entries.emplace_back(times[i], files[i]);
+  }
+  {
+    h5::Handle g = h5::open_group(root, "particles");
+    const hid_t gid = g.get();
+    const std::vector<std::size_t> shape = h5::dataset_shape(gid, "mass");
+    if (shape.size() != 1) {
+      throw std::runtime_error("checkpoint '" + path.string() + "': /particles/mass is not 1D");
+    }
+    const std::size_t n = shape[0];
+    const long long n_state = h5::read_int64_attribute(gid, "n_state_per_particle");
+    if (n_state < 0) {
+      throw std::runtime_error("checkpoint '" + path.string() + "': negative n_state_per_particle");
+    }
+    Particles<D>& ps = data.particles;
+    ps.n_state_per_particle = static_cast<int>(n_state);
+    ps.position = read_vecs<D>(gid, "position", n);
+    ps.reference_position = read_vecs<D>(gid, "reference_position", n);
+    ps.velocity = read_vecs<D>(gid, "velocity", n);
+    ps.mass = h5::read_doubles(gid, "mass", {n});
+    ps.volume0 = h5::read_doubles(gid, "volume0", {n});
+    ps.size0 = read_vecs<D>(gid, "size0", n);
+    ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
+    ps.kirchhoff_stress = read_mats(gid, "kirchhoff_stress", n);
+    ps.velocity_gradient = read_mats(gid, "velocity_gradient", n);
+    ps.material = h5::read_ints(gid, "material", n);
+    ps.body = h5::read_ints(gid, "body", n);
+    ps.state = h5::read_doubles(gid, "state", {n * static_cast<std::size_t>(n_state)});
+  }
+  return data;
+}
+
+int checkpoint_dimension(const fs::path& path) {
+  int dimension = 0;
+  h5::Handle file = open_checkpoint(path, dimension);
+  return dimension;
+}
+
+template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&);
+template void write_checkpoint<2>(const fs::path&, const CheckpointData<2>&);
+template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&);
+template CheckpointData<1> read_checkpoint<1>(const fs::path&);
+template CheckpointData<2> read_checkpoint<2>(const fs::path&);
+template CheckpointData<3> read_checkpoint<3>(const fs::path&);
+
+}  // namespace cairn

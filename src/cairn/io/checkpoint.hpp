@@ -1,0 +1,67 @@
+// Restart files: the complete state of a run, stored bit-exactly in HDF5.
+//
+// A checkpoint holds the resolved input (TOML text), the run-loop state, the history rows and
+// snapshot listing written so far, and every particle array. Reading it back and continuing
+// gives results identical to a run that was never interrupted. Files are written atomically.
+//
+// File layout (format "cairn-checkpoint", version 1):
+//   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index
+//   /config_toml                         scalar string
+//   /scalars/names, /scalars/values      run-loop scalars (string list, doubles)
+//   /history/columns, /history/rows      string list, rows x columns doubles
+//   /snapshots/times, /snapshots/files   snapshot listing (doubles, string list)
+//   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
+//     (n x D), mass, volume0 (n), deformation_gradient, kirchhoff_stress, velocity_gradient
+//     (n x 9, row-major), material, body (int32, n), state (n * n_state_per_particle)
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cairn/particles/particles.hpp"
+
+namespace cairn {
+
+/// Everything a run needs to continue exactly where it stopped.
+template <int D>
+struct CheckpointData {
+  std::string config_toml;  ///< the resolved input, as TOML text
+  double time = 0;
+  long long step = 0;
+  double previous_dt = 0;
+  std::map<std::string, double> scalars;  ///< run-loop state: external_work, next output times, ...
+  std::vector<std::string> history_columns;
+  std::vector<std::vector<double>> history_rows;
+  std::vector<std::pair<double, std::string>> snapshot_entries;
+  int snapshot_next_index = 0;
+  Particles<D> particles;
+};
+
+/// Current checkpoint format version written and accepted by this build.
+inline constexpr int checkpoint_format_version = 1;
+
+/// Write `data` to `path` atomically. Throws std::invalid_argument if the particle arrays have
+/// inconsistent lengths or the history rows differ in length, std::runtime_error on I/O errors.
+template <int D>
+void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data);
+
+/// Read a checkpoint written by write_checkpoint<D>. Throws std::runtime_error with a clear
+/// message if the file is missing, not HDF5, not a Cairn checkpoint, of another format version,
+/// of another dimension, or damaged.
+template <int D>
+CheckpointData<D> read_checkpoint(const std::filesystem::path& path);
+
+/// The simulation dimension stored in a checkpoint (checks format and version the same way).
+int checkpoint_dimension(const std::filesystem::path& path);
+
+extern template void write_checkpoint<1>(const std::filesystem::path&, const CheckpointData<1>&);
+extern template void write_checkpoint<2>(const std::filesystem::path&, const CheckpointData<2>&);
+extern template void write_checkpoint<3>(const std::filesystem::path&, const CheckpointData<3>&);
+extern template CheckpointData<1> read_checkpoint<1>(const std::filesystem::path&);
+extern template CheckpointData<2> read_checkpoint<2>(const std::filesystem::path&);
+extern template CheckpointData<3> read_checkpoint<3>(const std::filesystem::path&);
+
+}  // namespace cairn

@@ -1,0 +1,118 @@
+// The validated, resolved input of one simulation. Filled only by load_config() (io/input.hpp),
+// which has checked every key against its declaration; the rest of Cairn trusts these values.
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cairn/math/types.hpp"
+
+namespace cairn {
+
+/// Where a value came from, for error messages raised after validation (e.g. a body that
+/// produced no particle): "file.toml:12" or "--set method.order".
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+  [[nodiscard]] std::string str() const {
+    return line > 0 ? file + ":" + std::to_string(line) : file;
+  }
+};
+
+struct SimulationConfig {
+  std::string title;
+  int dimension = 2;
+  Mode mode = Mode::plane_strain;
+  double end_time = 0.0;
+  double cfl = 0.5;       ///< dt = cfl * h_min / (c_max + max|V|)  (seed 001 Eq. 34)
+  double fixed_dt = 0.0;  ///< > 0: use this time step instead of the CFL rule
+  long long max_steps = 0;  ///< 0: no limit
+  double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
+  int threads = 0;          ///< 0: OpenMP default
+};
+
+struct GridConfig {
+  std::vector<double> origin;     ///< D values
+  std::vector<double> extent;     ///< D values: domain size
+  std::vector<double> cell_size;  ///< D values (one given value is repeated)
+};
+
+struct MethodConfig {
+  std::string shape = "bspline2";
+  std::string update = "flip";
+  int order = 1;
+  std::string stress_update = "usl";
+  double smoothing_length = 0.0;  ///< uGIMP l; 0 = the initial particle size
+};
+
+/// A material's parameters after validation against the model's declared keys (defaults filled).
+struct MaterialConfig {
+  std::string name;
+  std::string model;
+  std::map<std::string, double> numbers;
+  std::map<std::string, std::string> strings;
+  SourceLocation where;
+  [[nodiscard]] bool has(const std::string& key) const { return numbers.count(key) != 0; }
+  [[nodiscard]] double number(const std::string& key) const { return numbers.at(key); }
+};
+
+struct BodyShapeConfig {
+  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere
+  std::vector<double> min, max;         ///< box
+  std::vector<double> center;           ///< circle, ellipse, annulus, sphere
+  double radius = 0.0;                  ///< circle, sphere
+  std::vector<double> semi_axes;        ///< ellipse (2D) / ellipsoid (3D)
+  double inner_radius = 0.0, outer_radius = 0.0;  ///< annulus
+  std::vector<std::vector<double>> vertices;      ///< polygon (2D)
+};
+
+struct BodyConfig {
+  std::string name;
+  std::string material;  ///< name of a [[material]]
+  BodyShapeConfig shape;
+  std::vector<int> particles_per_cell;  ///< per direction, D values (one given value is repeated)
+  std::vector<std::string> velocity;    ///< D expressions in X,Y,Z (numbers are expressions too)
+  std::vector<std::string> displacement;  ///< D expressions in X,Y,Z; empty = none
+  SourceLocation where;
+};
+
+enum class FaceCondition { free, fixed, symmetry, periodic };
+
+struct BoundaryConfig {
+  /// Index 2*axis + side (side 0 = min face, 1 = max face).
+  std::array<FaceCondition, 6> face{FaceCondition::free, FaceCondition::free, FaceCondition::free,
+                                    FaceCondition::free, FaceCondition::free, FaceCondition::free};
+};
+
+struct BodyForceConfig {
+  std::vector<std::string> expression;  ///< D expressions in x,y,z,X,Y,Z,t; empty = no body force
+};
+
+struct OutputConfig {
+  std::string directory;        ///< default out/<input file stem>
+  double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
+  double history_every = 0.0;   ///< history interval; 0 = same as `every`
+  double checkpoint_every = 0.0;///< checkpoint interval; 0 = only at the end
+  bool snapshots = true;        ///< write HDF5/XDMF particle snapshots
+  bool grid_snapshots = false;  ///< also write node fields
+  bool checkpoints = true;
+};
+
+struct Config {
+  std::string source_file;  ///< path of the input file ("" if built in code)
+  std::string resolved_toml;///< the fully resolved input (defaults filled, overrides applied)
+  SimulationConfig simulation;
+  GridConfig grid;
+  MethodConfig method;
+  std::vector<MaterialConfig> materials;
+  std::vector<BodyConfig> bodies;
+  BoundaryConfig boundary;
+  BodyForceConfig body_force;
+  std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
+  OutputConfig output;
+};
+
+}  // namespace cairn

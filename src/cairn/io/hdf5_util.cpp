@@ -1,0 +1,384 @@
+#include "cairn/io/hdf5_util.hpp"
+
+#include <algorithm>
+#include <mutex>
+#include <stdexcept>
+
+namespace cairn::h5 {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& what, hid_t loc, const std::string& name) {
+  throw std::runtime_error("HDF5: " + what + " " + describe(loc, name));
+}
+
+/// Throw if an identifier-returning call failed; otherwise wrap it.
+Handle checked(hid_t id, Handle::Closer close, const std::string& what, hid_t loc,
+               const std::string& name) {
+  if (id < 0) fail(what, loc, name);
+  return Handle(id, close);
+}
+
+void check(herr_t status, const std::string& what, hid_t loc, const std::string& name) {
+  if (status < 0) fail(what, loc, name);
+}
+
+Handle simple_space(const std::vector<hsize_t>& dims, hid_t loc, const std::string& name) {
+  return checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose,
+                 "cannot create dataspace for", loc, name);
+}
+
+/// Create dataset `name` of file type `ftype` over `dims` and write `data` (memory type `mtype`).
+void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
+                   const std::vector<hsize_t>& dims, const void* data) {
+  Handle space = simple_space(dims, loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
+                                   H5P_DEFAULT, H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  if (total > 0) {
+    check(H5Dwrite(dset.get(), mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+          "cannot write dataset", loc, name);
+  }
+}
+
+Handle open_dataset(hid_t loc, const std::string& name) {
+  if (!has_child(loc, name)) fail("missing dataset", loc, name);
+  return checked(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose, "cannot open dataset", loc,
+                 name);
+}
+
+std::vector<std::size_t> space_shape(hid_t space, hid_t loc, const std::string& name) {
+  int rank = H5Sget_simple_extent_ndims(space);
+  if (rank < 0) fail("cannot query the shape of", loc, name);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  if (rank > 0 && H5Sget_simple_extent_dims(space, dims.data(), nullptr) < 0) {
+    fail("cannot query the shape of", loc, name);
+  }
+  return {dims.begin(), dims.end()};
+}
+
+std::string shape_str(const std::vector<std::size_t>& shape) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    if (i > 0) s += ", ";
+    s += std::to_string(shape[i]);
+  }
+  return s + ")";
+}
+
+/// Open `name` and check that it is a numeric dataset of the given shape.
+Handle open_numeric(hid_t loc, const std::string& name, H5T_class_t cls,
+                    const std::vector<std::size_t>& shape) {
+  Handle dset = open_dataset(loc, name);
+  Handle type = checked(H5Dget_type(dset.get()), H5Tclose, "cannot get the type of", loc, name);
+  if (H5Tget_class(type.get()) != cls) {
+    fail(cls == H5T_FLOAT ? "expected a floating-point dataset:" : "expected an integer dataset:",
+         loc, name);
+  }
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  std::vector<std::size_t> actual = space_shape(space.get(), loc, name);
+  if (actual != shape) {
+    fail("shape " + shape_str(actual) + " differs from the expected " + shape_str(shape) + " in",
+         loc, name);
+  }
+  return dset;
+}
+
+/// Fixed-length string type of `size` bytes (at least 1), NUL-padded.
+Handle string_type(std::size_t size, hid_t loc, const std::string& name) {
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", loc, name);
+  check(H5Tset_size(type.get(), std::max<std::size_t>(size, 1)), "cannot size string type for",
+        loc, name);
+  check(H5Tset_strpad(type.get(), H5T_STR_NULLPAD), "cannot set string padding for", loc, name);
+  return type;
+}
+
+/// Text up to the first NUL of a fixed-length string buffer.
+std::string trim_nul(const char* data, std::size_t size) {
+  const char* end = std::find(data, data + size, '\0');
+  return {data, end};
+}
+
+Handle open_attribute(hid_t obj, const std::string& name) {
+  if (!has_attribute(obj, name)) fail("missing attribute", obj, name);
+  return checked(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, "cannot open attribute", obj,
+                 name);
+}
+
+/// Open a numeric attribute and return its number of elements.
+Handle open_numeric_attribute(hid_t obj, const std::string& name, bool integer_only,
+                              hssize_t& count) {
+  Handle attr = open_attribute(obj, name);
+  Handle type = checked(H5Aget_type(attr.get()), H5Tclose, "cannot get the type of attribute", obj, name);
+  H5T_class_t cls = H5Tget_class(type.get());
+  if (cls != H5T_INTEGER && (integer_only || cls != H5T_FLOAT)) {
+    fail(integer_only ? "expected an integer attribute:" : "expected a numeric attribute:", obj, name);
+  }
+  Handle space = checked(H5Aget_space(attr.get()), H5Sclose, "cannot get the dataspace of attribute", obj, name);
+  count = H5Sget_simple_extent_npoints(space.get());
+  if (count < 0) fail("cannot query the size of attribute", obj, name);
+  return attr;
+}
+
+void write_attribute(hid_t obj, const std::string& name, hid_t ftype, hid_t mtype, hid_t space,
+                     const void* data) {
+  if (has_attribute(obj, name)) check(H5Adelete(obj, name.c_str()), "cannot replace attribute", obj, name);
+  Handle attr = checked(H5Acreate2(obj, name.c_str(), ftype, space, H5P_DEFAULT, H5P_DEFAULT),
+                        H5Aclose, "cannot create attribute", obj, name);
+  check(H5Awrite(attr.get(), mtype, data), "cannot write attribute", obj, name);
+}
+
+Handle scalar_space(hid_t obj, const std::string& name) {
+  return checked(H5Screate(H5S_SCALAR), H5Sclose, "cannot create dataspace for attribute", obj, name);
+}
+
+}  // namespace
+
+void silence_errors() {
+  static std::once_flag once;
+  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+}
+
+std::string describe(hid_t loc, const std::string& name) {
+  std::string file = "?";
+  std::string path;
+  ssize_t len = H5Fget_name(loc, nullptr, 0);
+  if (len >= 0) {
+    file.assign(static_cast<std::size_t>(len) + 1, '\0');
+    H5Fget_name(loc, file.data(), file.size());
+    file.resize(static_cast<std::size_t>(len));
+  }
+  len = H5Iget_name(loc, nullptr, 0);
+  if (len > 0) {
+    path.assign(static_cast<std::size_t>(len) + 1, '\0');
+    H5Iget_name(loc, path.data(), path.size());
+    path.resize(static_cast<std::size_t>(len));
+  }
+  if (path == "/") path.clear();
+  std::string object = name.empty() ? (path.empty() ? "/" : path) : path + "/" + name;
+  return "'" + file + ":" + object + "'";
+}
+
+Handle create_file(const fs::path& path) {
+  silence_errors();
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (fapl.get() < 0 || H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0) {
+    throw std::runtime_error("HDF5: cannot set up file access for '" + path.string() + "'");
+  }
+  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+  if (id < 0) throw std::runtime_error("HDF5: cannot create file '" + path.string() + "'");
+  return Handle(id, H5Fclose);
+}
+
+Handle open_file(const fs::path& path) {
+  silence_errors();
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    throw std::runtime_error("file '" + path.string() + "' does not exist or is not a regular file");
+  }
+  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) throw std::runtime_error("'" + path.string() + "' is not a readable HDF5 file");
+  return Handle(id, H5Fclose);
+}
+
+Handle create_group(hid_t loc, const std::string& name) {
+  return checked(H5Gcreate2(loc, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                 "cannot create group", loc, name);
+}
+
+Handle open_group(hid_t loc, const std::string& name) {
+  if (!has_child(loc, name)) fail("missing group", loc, name);
+  return checked(H5Gopen2(loc, name.c_str(), H5P_DEFAULT), H5Gclose, "cannot open group", loc, name);
+}
+
+bool has_child(hid_t loc, const std::string& name) {
+  htri_t exists = H5Lexists(loc, name.c_str(), H5P_DEFAULT);
+  if (exists < 0) fail("cannot look up", loc, name);
+  return exists > 0;
+}
+
+void write_doubles(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                   std::size_t cols) {
+  std::vector<hsize_t> dims{rows};
+  if (cols > 0) dims.push_back(cols);
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+}
+
+void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
+                          const std::vector<std::size_t>& shape) {
+  std::vector<hsize_t> dims(shape.begin(), shape.end());
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+}
+
+void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n) {
+  write_dataset(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, data);
+}
+
+void write_text(hid_t loc, const std::string& name, const std::string& text) {
+  Handle type = string_type(text.size(), loc, name);
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "cannot create dataspace for", loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), type.get(), space.get(), H5P_DEFAULT,
+                                   H5P_DEFAULT, H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  std::string buffer = text;
+  buffer.resize(std::max<std::size_t>(text.size(), 1), '\0');
+  check(H5Dwrite(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+        "cannot write dataset", loc, name);
+}
+
+void write_text_list(hid_t loc, const std::string& name, const std::vector<std::string>& list) {
+  std::size_t width = 1;
+  for (const auto& s : list) width = std::max(width, s.size());
+  std::string buffer(width * list.size(), '\0');
+  for (std::size_t i = 0; i < list.size(); ++i) std::copy(list[i].begin(), list[i].end(), buffer.begin() + static_cast<std::ptrdiff_t>(i * width));
+  Handle type = string_type(width, loc, name);
+  write_dataset(loc, name, type.get(), type.get(), {list.size()}, buffer.data());
+}
+
+std::vector<std::size_t> dataset_shape(hid_t loc, const std::string& name) {
+  Handle dset = open_dataset(loc, name);
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  return space_shape(space.get(), loc, name);
+}
+
+std::vector<double> read_doubles(hid_t loc, const std::string& name,
+                                 const std::vector<std::size_t>& shape) {
+  Handle dset = open_numeric(loc, name, H5T_FLOAT, shape);
+  std::size_t total = 1;
+  for (std::size_t d : shape) total *= d;
+  std::vector<double> data(total);
+  if (total > 0) {
+    check(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
+          "cannot read dataset", loc, name);
+  }
+  return data;
+}
+
+std::vector<std::int32_t> read_ints(hid_t loc, const std::string& name, std::size_t n) {
+  Handle dset = open_numeric(loc, name, H5T_INTEGER, {n});
+  std::vector<std::int32_t> data(n);
+  if (n > 0) {
+    check(H5Dread(dset.get(), H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
+          "cannot read dataset", loc, name);
+  }
+  return data;
+}
+
+std::string read_text(hid_t loc, const std::string& name) {
+  Handle dset = open_dataset(loc, name);
+  Handle type = checked(H5Dget_type(dset.get()), H5Tclose, "cannot get the type of", loc, name);
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0) {
+    fail("expected a fixed-length string dataset:", loc, name);
+  }
+  std::size_t size = H5Tget_size(type.get());
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  if (H5Sget_simple_extent_npoints(space.get()) != 1) fail("expected a scalar string:", loc, name);
+  Handle mtype = string_type(size, loc, name);
+  std::string buffer(size, '\0');
+  check(H5Dread(dset.get(), mtype.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+        "cannot read dataset", loc, name);
+  return trim_nul(buffer.data(), size);
+}
+
+std::vector<std::string> read_text_list(hid_t loc, const std::string& name) {
+  Handle dset = open_dataset(loc, name);
+  Handle type = checked(H5Dget_type(dset.get()), H5Tclose, "cannot get the type of", loc, name);
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0) {
+    fail("expected a fixed-length string dataset:", loc, name);
+  }
+  std::size_t width = H5Tget_size(type.get());
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  std::vector<std::size_t> shape = space_shape(space.get(), loc, name);
+  if (shape.size() != 1) fail("expected a 1D string dataset:", loc, name);
+  std::vector<std::string> list;
+  if (shape[0] == 0) return list;
+  Handle mtype = string_type(width, loc, name);
+  std::string buffer(width * shape[0], '\0');
+  check(H5Dread(dset.get(), mtype.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+        "cannot read dataset", loc, name);
+  for (std::size_t i = 0; i < shape[0]; ++i) list.push_back(trim_nul(buffer.data() + i * width, width));
+  return list;
+}
+
+bool has_attribute(hid_t obj, const std::string& name) {
+  htri_t exists = H5Aexists(obj, name.c_str());
+  if (exists < 0) fail("cannot look up attribute", obj, name);
+  return exists > 0;
+}
+
+void write_string_attribute(hid_t obj, const std::string& name, const std::string& value) {
+  Handle type = string_type(value.size(), obj, name);
+  Handle space = scalar_space(obj, name);
+  std::string buffer = value;
+  buffer.resize(std::max<std::size_t>(value.size(), 1), '\0');
+  write_attribute(obj, name, type.get(), type.get(), space.get(), buffer.data());
+}
+
+void write_double_attribute(hid_t obj, const std::string& name, double value) {
+  Handle space = scalar_space(obj, name);
+  write_attribute(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, space.get(), &value);
+}
+
+void write_doubles_attribute(hid_t obj, const std::string& name, const std::vector<double>& values) {
+  Handle space = simple_space({values.size()}, obj, name);
+  write_attribute(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, space.get(), values.data());
+}
+
+void write_int64_attribute(hid_t obj, const std::string& name, long long value) {
+  Handle space = scalar_space(obj, name);
+  write_attribute(obj, name, H5T_STD_I64LE, H5T_NATIVE_LLONG, space.get(), &value);
+}
+
+std::string read_string_attribute(hid_t obj, const std::string& name) {
+  Handle attr = open_attribute(obj, name);
+  Handle type = checked(H5Aget_type(attr.get()), H5Tclose, "cannot get the type of attribute", obj, name);
+  if (H5Tget_class(type.get()) != H5T_STRING) fail("expected a string attribute:", obj, name);
+  Handle space = checked(H5Aget_space(attr.get()), H5Sclose, "cannot get the dataspace of attribute", obj, name);
+  if (H5Sget_simple_extent_npoints(space.get()) != 1) fail("expected a scalar string attribute:", obj, name);
+  if (H5Tis_variable_str(type.get()) > 0) {
+    Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
+    check(H5Tset_size(mtype.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+    char* text = nullptr;
+    check(H5Aread(attr.get(), mtype.get(), &text), "cannot read attribute", obj, name);
+    std::string value = text != nullptr ? std::string(text) : std::string();
+    H5free_memory(text);
+    return value;
+  }
+  std::size_t size = H5Tget_size(type.get());
+  Handle mtype = string_type(size, obj, name);
+  std::string buffer(size, '\0');
+  check(H5Aread(attr.get(), mtype.get(), buffer.data()), "cannot read attribute", obj, name);
+  return trim_nul(buffer.data(), size);
+}
+
+double read_double_attribute(hid_t obj, const std::string& name) {
+  hssize_t count = 0;
+  Handle attr = open_numeric_attribute(obj, name, false, count);
+  if (count != 1) fail("expected a scalar attribute:", obj, name);
+  double value = 0.0;
+  check(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &value), "cannot read attribute", obj, name);
+  return value;
+}
+
+std::vector<double> read_doubles_attribute(hid_t obj, const std::string& name) {
+  hssize_t count = 0;
+  Handle attr = open_numeric_attribute(obj, name, false, count);
+  std::vector<double> values(static_cast<std::size_t>(count));
+  if (count > 0) check(H5Aread(attr.get(), H5T_NATIVE_DOUBLE, values.data()), "cannot read attribute", obj, name);
+  return values;
+}
+
+long long read_int64_attribute(hid_t obj, const std::string& name) {
+  hssize_t count = 0;
+  Handle attr = open_numeric_attribute(obj, name, true, count);
+  if (count != 1) fail("expected a scalar attribute:", obj, name);
+  long long value = 0;
+  check(H5Aread(attr.get(), H5T_NATIVE_LLONG, &value), "cannot read attribute", obj, name);
+  return value;
+}
+
+}  // namespace cairn::h5

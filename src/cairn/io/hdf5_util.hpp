@@ -1,0 +1,113 @@
+// Internal helpers over the HDF5 C API for Cairn's snapshot and checkpoint files.
+//
+// Handles are RAII-owned; every failing HDF5 call throws std::runtime_error naming the file and
+// the object involved. HDF5's own automatic error printing is switched off (silence_errors() is
+// called by create_file() and open_file()), so the exceptions are the only report.
+// Not part of the public interface of the io module: use snapshot.hpp and checkpoint.hpp.
+#pragma once
+
+#include <hdf5.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace cairn::h5 {
+
+/// Switch off HDF5's automatic printing of its error stack (idempotent, thread-safe).
+void silence_errors();
+
+/// Owning wrapper of an HDF5 identifier; closes it with the matching H5?close on destruction.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle() = default;
+  /// Take ownership of `id`, to be released with `close`.
+  Handle(hid_t id, Closer close) : id_(id), close_(close) {}
+  ~Handle() { reset(); }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = H5I_INVALID_HID; }
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) {
+      reset();
+      id_ = other.id_;
+      close_ = other.close_;
+      other.id_ = H5I_INVALID_HID;
+    }
+    return *this;
+  }
+  /// The identifier (still owned by this handle).
+  [[nodiscard]] hid_t get() const { return id_; }
+  /// Close the identifier now (no-op if empty).
+  void reset() {
+    if (id_ >= 0 && close_ != nullptr) close_(id_);
+    id_ = H5I_INVALID_HID;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+  Closer close_ = nullptr;
+};
+
+/// Create (truncate) an HDF5 file for writing.
+[[nodiscard]] Handle create_file(const std::filesystem::path& path);
+/// Open an existing HDF5 file read-only. Throws if it does not exist or is not HDF5.
+[[nodiscard]] Handle open_file(const std::filesystem::path& path);
+/// Create a group `name` below `loc`.
+[[nodiscard]] Handle create_group(hid_t loc, const std::string& name);
+/// Open the existing group `name` below `loc`.
+[[nodiscard]] Handle open_group(hid_t loc, const std::string& name);
+/// Whether `loc` has a direct child link called `name`.
+[[nodiscard]] bool has_child(hid_t loc, const std::string& name);
+
+/// Write a double dataset: 1D of length `rows` if `cols` == 0, else rows x cols (row-major).
+void write_doubles(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                   std::size_t cols = 0);
+/// Write a double dataset of any rank with the given shape (row-major, last index fastest).
+void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
+                          const std::vector<std::size_t>& shape);
+/// Write a 1D int32 dataset of length `n`.
+void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n);
+/// Write a text (any length, no embedded NUL) as a scalar fixed-length string dataset.
+void write_text(hid_t loc, const std::string& name, const std::string& text);
+/// Write a 1D dataset of fixed-length strings.
+void write_text_list(hid_t loc, const std::string& name, const std::vector<std::string>& list);
+
+/// Shape of the dataset `name` below `loc` (empty for a scalar dataset).
+[[nodiscard]] std::vector<std::size_t> dataset_shape(hid_t loc, const std::string& name);
+/// Read a double dataset whose shape must be exactly `shape`; throws otherwise.
+[[nodiscard]] std::vector<double> read_doubles(hid_t loc, const std::string& name,
+                                               const std::vector<std::size_t>& shape);
+/// Read a 1D int32 dataset of length exactly `n`; throws otherwise.
+[[nodiscard]] std::vector<std::int32_t> read_ints(hid_t loc, const std::string& name, std::size_t n);
+/// Read a scalar string dataset written by write_text().
+[[nodiscard]] std::string read_text(hid_t loc, const std::string& name);
+/// Read a 1D string dataset written by write_text_list().
+[[nodiscard]] std::vector<std::string> read_text_list(hid_t loc, const std::string& name);
+
+/// Whether the object `obj` (file, group or dataset) has an attribute `name`.
+[[nodiscard]] bool has_attribute(hid_t obj, const std::string& name);
+/// Attach a string attribute (fixed-length) to `obj`.
+void write_string_attribute(hid_t obj, const std::string& name, const std::string& value);
+/// Attach a scalar double attribute to `obj`.
+void write_double_attribute(hid_t obj, const std::string& name, double value);
+/// Attach a 1D double array attribute to `obj`.
+void write_doubles_attribute(hid_t obj, const std::string& name, const std::vector<double>& values);
+/// Attach a scalar int64 attribute to `obj`.
+void write_int64_attribute(hid_t obj, const std::string& name, long long value);
+/// Read a string attribute (fixed- or variable-length).
+[[nodiscard]] std::string read_string_attribute(hid_t obj, const std::string& name);
+/// Read a scalar numeric attribute as double.
+[[nodiscard]] double read_double_attribute(hid_t obj, const std::string& name);
+/// Read a 1D numeric array attribute as doubles.
+[[nodiscard]] std::vector<double> read_doubles_attribute(hid_t obj, const std::string& name);
+/// Read a scalar integer attribute as int64.
+[[nodiscard]] long long read_int64_attribute(hid_t obj, const std::string& name);
+
+/// "'<file>:<object path>/<name>'" for error messages.
+[[nodiscard]] std::string describe(hid_t loc, const std::string& name);
+
+}  // namespace cairn::h5

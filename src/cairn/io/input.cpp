@@ -1,0 +1,1230 @@
+// The input validator: TOML (toml++) + `--set` overrides -> Config, checking every key against its
+// declaration in io/schema.cpp. Errors name file:line (toml++ source positions) or the `--set`
+// text, the key, what was expected and what was found.
+#include "cairn/io/input.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cstdint>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "cairn/io/schema.hpp"
+#include "cairn/materials/material.hpp"
+
+namespace cairn {
+
+namespace {
+
+/// A key's position in the input tree: {"material", "0", "density"}.
+using Path = std::vector<std::string>;
+
+constexpr double ratio_tolerance = 1e-9;  ///< extent / cell_size must be this close to a whole number
+
+Path child(Path p, std::string part) {
+  p.push_back(std::move(part));
+  return p;
+}
+Path child(Path p, std::size_t index) { return child(std::move(p), std::to_string(index)); }
+
+bool is_index(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+/// Dotted key as users see it: {"material", "0", "density"} -> "material[0].density".
+std::string display(const Path& p) {
+  std::string out;
+  for (const auto& part : p) {
+    if (is_index(part) && !out.empty()) out += "[" + part + "]";
+    else out += (out.empty() ? "" : ".") + part;
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::string>& items, const std::string& sep = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
+  return out;
+}
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                        std::tolower(static_cast<unsigned char>(b[j - 1]));
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// The candidate closest to `name` when it is plausibly a misspelling of it.
+std::optional<std::string> closest(const std::string& name, const std::vector<std::string>& candidates) {
+  std::optional<std::string> best;
+  std::size_t best_distance = std::max<std::size_t>(2, name.size() / 3) + 1;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(name, c);
+    if (d < best_distance && d < std::max(name.size(), c.size())) {
+      best = c;
+      best_distance = d;
+    }
+  }
+  return best;
+}
+
+std::string did_you_mean(const std::string& name, const std::vector<std::string>& candidates) {
+  auto c = closest(name, candidates);
+  return c ? fmt::format(" (did you mean '{}'?)", *c) : "";
+}
+
+// ---- TOML text ---------------------------------------------------------------------------
+
+std::string toml_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      case '\b': out += "\\b"; break;
+      case '\f': out += "\\f"; break;
+      default:
+        if (c < 0x20 || c == 0x7f) out += fmt::format("\\u{:04X}", static_cast<unsigned>(c));
+        else out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string toml_key(const std::string& k) {
+  const bool bare = !k.empty() && std::all_of(k.begin(), k.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+  return bare ? k : toml_string(k);
+}
+
+/// Shortest text that reads back as the same double, always with a '.' or exponent so that
+/// TOML reads it as a real.
+std::string real_text(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// Full-precision text of a number stored in an expression (Config keeps expressions as text).
+std::string expression_number(double v) { return fmt::format("{:.17g}", v); }
+
+std::string node_text(const toml::node& node) {
+  std::string out;
+  if (auto s = node.as_string()) out = toml_string(s->get());
+  else if (auto i = node.as_integer()) out = fmt::format("{}", i->get());
+  else if (auto f = node.as_floating_point()) out = real_text(f->get());
+  else if (auto b = node.as_boolean()) out = b->get() ? "true" : "false";
+  else if (auto a = node.as_array()) {
+    out = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) out += (i ? ", " : "") + node_text(*a->get(i));
+    out += "]";
+  } else if (auto t = node.as_table()) {
+    out = "{";
+    bool first = true;
+    for (auto&& [k, v] : *t) {
+      out += fmt::format("{} {} = {}", first ? "" : ",", toml_key(std::string(k.str())), node_text(v));
+      first = false;
+    }
+    out += first ? "}" : " }";
+  } else {
+    std::ostringstream os;
+    node.visit([&](auto&& v) { os << v; });
+    out = os.str();
+  }
+  if (out.size() > 120) out = out.substr(0, 117) + "...";
+  return out;
+}
+
+std::string type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a real";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date/time";
+  }
+}
+
+/// "value (its type)", for type errors.
+std::string typed_text(const toml::node& node) {
+  return fmt::format("{} ({})", node_text(node), type_name(node));
+}
+
+int line_of(const toml::node* node) {
+  return node ? static_cast<int>(node->source().begin.line) : 0;
+}
+
+/// Entries of a table sorted by their position in the file (toml++ keeps them sorted by key).
+std::vector<std::pair<std::string, const toml::node*>> entries_in_file_order(const toml::table& t) {
+  std::vector<std::pair<std::string, const toml::node*>> out;
+  for (auto&& [k, v] : t) out.emplace_back(std::string(k.str()), &v);
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    const auto& sa = a.second->source().begin;
+    const auto& sb = b.second->source().begin;
+    return sa.line != sb.line ? sa.line < sb.line : sa.column < sb.column;
+  });
+  return out;
+}
+
+std::string mode_name(Mode m) {
+  switch (m) {
+    case Mode::uniaxial_strain_1d: return "uniaxial";
+    case Mode::plane_strain: return "plane_strain";
+    case Mode::plane_stress: return "plane_stress";
+    case Mode::three_d: return "3d";
+  }
+  return "?";
+}
+
+const char* const face_names[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+const char* const face_condition_names[4] = {"free", "fixed", "symmetry", "periodic"};
+
+/// " (one per axis, dimension 2)" when n is the dimension.
+std::string per_axis(std::size_t n, int dim) {
+  return n == static_cast<std::size_t>(dim) ? fmt::format(" (one per axis, dimension {})", dim) : "";
+}
+
+std::vector<KeyDecl> copy_section(std::string_view section) {
+  std::vector<KeyDecl> out;
+  for (const auto* d : section_keys(section)) out.push_back(*d);
+  return out;
+}
+
+// ---- the validator -----------------------------------------------------------------------
+
+class Loader;
+
+/// Reads one table against its declared keys: defaults, types, ranges, choices, array lengths.
+class TableReader {
+ public:
+  /// `table` may be null (section absent: every key takes its default). `what` names the table
+  /// in messages about unknown keys, e.g. "[simulation]".
+  TableReader(Loader& loader, const toml::table* table, Path path, std::vector<KeyDecl> decls,
+              std::string what)
+      : loader_(loader), table_(table), path_(std::move(path)), decls_(std::move(decls)),
+        what_(std::move(what)) {}
+
+  void reject_unknown_keys() const;
+
+  /// The node given in the input for `name`, or null.
+  [[nodiscard]] const toml::node* given(const std::string& name) const {
+    return table_ ? table_->get(name) : nullptr;
+  }
+  [[nodiscard]] bool present(const std::string& name) const { return given(name) != nullptr; }
+  [[nodiscard]] Path path_of(const std::string& name) const { return child(path_, name); }
+  [[nodiscard]] const toml::table* table() const { return table_; }
+
+  [[nodiscard]] double real(const std::string& name);
+  [[nodiscard]] long long integer(const std::string& name);
+  [[nodiscard]] int small_integer(const std::string& name);
+  [[nodiscard]] bool boolean(const std::string& name);
+  [[nodiscard]] std::string string(const std::string& name);
+  /// n numbers; with allow_scalar one number stands for all n.
+  [[nodiscard]] std::vector<double> reals(const std::string& name, std::size_t n, bool allow_scalar);
+  [[nodiscard]] std::vector<int> integers(const std::string& name, std::size_t n, bool allow_scalar);
+  /// n entries, numbers or non-empty strings, as expression text; empty when absent.
+  [[nodiscard]] std::vector<std::string> expressions(const std::string& name, std::size_t n);
+  /// At least min_count points of n coordinates each ([[x, y], ...]).
+  [[nodiscard]] std::vector<std::vector<double>> points(const std::string& name, std::size_t n,
+                                                        std::size_t min_count);
+
+  [[noreturn]] void fail(const std::string& name, const toml::node* node, const std::string& expected,
+                         const std::string& found) const;
+
+ private:
+  struct Value {
+    const toml::node* node = nullptr;
+    bool is_default = false;
+    const KeyDecl* decl = nullptr;
+  };
+  [[nodiscard]] const KeyDecl& decl(const std::string& name) const;
+  /// The given value or the default; node is null for an optional key without default.
+  Value value(const std::string& name);
+  Value required_value(const std::string& name);
+  /// Found text for a value; defaults are marked, since the user did not write them.
+  static std::string found(const Value& v, bool typed) {
+    std::string s = typed ? typed_text(*v.node) : node_text(*v.node);
+    return v.is_default ? s + " (the default)" : s;
+  }
+  double number(const Value& v, const Path& path, const std::string& expected);
+  void check_range(const Value& v, double x, const Path& path, const std::string& expected);
+  const toml::array& array_of(const Value& v, const std::string& name, std::size_t n,
+                              const std::string& expected);
+
+  Loader& loader_;
+  const toml::table* table_;
+  Path path_;
+  std::vector<KeyDecl> decls_;
+  std::string what_;
+};
+
+/// Applies overrides, validates the whole input and builds the Config.
+class Loader {
+ public:
+  explicit Loader(std::string file) : file_(std::move(file)) {}
+
+  Config load(toml::table& root, const std::vector<std::string>& overrides);
+
+  /// Where the value at `path` came from: the `--set` that wrote it, else the node's line.
+  [[nodiscard]] SourceLocation locate(const Path& path, const toml::node* node) const {
+    const Path* best = nullptr;
+    const std::string* origin = nullptr;
+    for (const auto& [p, text] : overrides_)
+      if (p.size() <= path.size() && std::equal(p.begin(), p.end(), path.begin()) &&
+          (!best || p.size() >= best->size())) {
+        best = &p;
+        origin = &text;
+      }
+    if (origin) return {*origin, 0};
+    return {file_, line_of(node)};
+  }
+
+  [[noreturn]] void fail(const Path& path, const toml::node* node, const std::string& expected,
+                         const std::string& found) const {
+    const SourceLocation where = locate(path, node);
+    throw InputError(where.file, where.line, display(path), expected, found);
+  }
+
+  /// Parsed default value (kept alive for the loader's lifetime).
+  const toml::node* default_node(const KeyDecl& decl) {
+    defaults_.push_back(toml::parse("v = " + decl.default_value));
+    return defaults_.back().get("v");
+  }
+
+  [[nodiscard]] int dimension() const { return dim_; }
+
+ private:
+  void apply_override(toml::table& root, const std::string& text);
+  void check_top_level(const toml::table& root) const;
+  void read_simulation(const toml::table& root, Config& cfg);
+  void read_grid(const toml::table& root, Config& cfg);
+  void read_method(const toml::table& root, Config& cfg);
+  void read_constants(const toml::table& root, Config& cfg);
+  void read_materials(const toml::table& root, Config& cfg);
+  void read_bodies(const toml::table& root, Config& cfg);
+  BodyShapeConfig read_shape(TableReader& body);
+  void read_boundary(const toml::table& root, Config& cfg);
+  void read_body_force(const toml::table& root, Config& cfg);
+  void read_output(const toml::table& root, Config& cfg);
+
+  const toml::table* section(const toml::table& root, const std::string& name) const {
+    return root.get_as<toml::table>(name);
+  }
+
+  std::string file_;
+  std::vector<std::pair<Path, std::string>> overrides_;  ///< path -> "--set <text>"
+  std::deque<toml::table> defaults_;
+  int dim_ = 0;
+};
+
+// ---- TableReader ---------------------------------------------------------------------------
+
+const KeyDecl& TableReader::decl(const std::string& name) const {
+  for (const auto& d : decls_)
+    if (d.name == name) return d;
+  throw std::logic_error("input: key '" + display(path_of(name)) + "' read but not declared");
+}
+
+void TableReader::fail(const std::string& name, const toml::node* node, const std::string& expected,
+                       const std::string& found) const {
+  loader_.fail(path_of(name), node ? node : table_, expected, found);
+}
+
+void TableReader::reject_unknown_keys() const {
+  if (!table_) return;
+  std::vector<std::string> names;
+  for (const auto& d : decls_) names.push_back(d.name);
+  for (const auto& [key, node] : entries_in_file_order(*table_)) {
+    if (std::find(names.begin(), names.end(), key) != names.end()) continue;
+    const auto suggestion = closest(key, names);
+    const std::string expected =
+        suggestion ? fmt::format("a key declared for {} (did you mean '{}'?)", what_, *suggestion)
+                   : fmt::format("one of the keys of {}: {}", what_, join(names));
+    loader_.fail(path_of(key), node, expected, "an undeclared key");
+  }
+}
+
+TableReader::Value TableReader::value(const std::string& name) {
+  Value v;
+  v.decl = &decl(name);
+  v.node = given(name);
+  if (!v.node && !v.decl->default_value.empty()) {
+    v.node = loader_.default_node(*v.decl);
+    v.is_default = true;
+  }
+  return v;
+}
+
+TableReader::Value TableReader::required_value(const std::string& name) {
+  Value v = value(name);
+  if (!v.node) fail(name, nullptr, expected_value_text(*v.decl) + " (required key)", "nothing");
+  return v;
+}
+
+double TableReader::number(const Value& v, const Path& path, const std::string& expected) {
+  double x = 0.0;
+  if (auto i = v.node->as_integer()) x = static_cast<double>(i->get());
+  else if (auto f = v.node->as_floating_point()) x = f->get();
+  else loader_.fail(path, v.node, expected, found(v, true));
+  if (!std::isfinite(x)) loader_.fail(path, v.node, expected + " (finite)", found(v, false));
+  return x;
+}
+
+void TableReader::check_range(const Value& v, double x, const Path& path, const std::string& expected) {
+  if ((v.decl->min && x < *v.decl->min) || (v.decl->max && x > *v.decl->max))
+    loader_.fail(path, v.node, expected, found(v, false));
+}
+
+double TableReader::real(const std::string& name) {
+  Value v = required_value(name);
+  const std::string expected = expected_value_text(*v.decl);
+  const double x = number(v, path_of(name), expected);
+  check_range(v, x, path_of(name), expected);
+  return x;
+}
+
+long long TableReader::integer(const std::string& name) {
+  Value v = required_value(name);
+  const std::string expected = expected_value_text(*v.decl);
+  auto i = v.node->as_integer();
+  if (!i) fail(name, v.node, expected, found(v, true));
+  check_range(v, static_cast<double>(i->get()), path_of(name), expected);
+  return i->get();
+}
+
+int TableReader::small_integer(const std::string& name) {
+  const long long x = integer(name);
+  if (x > INT_MAX || x < INT_MIN)
+    fail(name, given(name), expected_value_text(decl(name)) + fmt::format(" (at most {})", INT_MAX),
+         fmt::format("{}", x));
+  return static_cast<int>(x);
+}
+
+bool TableReader::boolean(const std::string& name) {
+  Value v = required_value(name);
+  auto b = v.node->as_boolean();
+  if (!b) fail(name, v.node, expected_value_text(*v.decl), found(v, true));
+  return b->get();
+}
+
+std::string TableReader::string(const std::string& name) {
+  Value v = required_value(name);
+  auto s = v.node->as_string();
+  if (!s) {
+    const std::string expected =
+        v.decl->choices ? expected_value_text(*v.decl) + " (a string)" : "a string";
+    fail(name, v.node, expected, found(v, true));
+  }
+  if (v.decl->choices) {
+    const auto choices = v.decl->choices();
+    if (std::find(choices.begin(), choices.end(), s->get()) == choices.end())
+      fail(name, v.node, expected_value_text(*v.decl) + did_you_mean(s->get(), choices),
+           found(v, false));
+  }
+  return s->get();
+}
+
+const toml::array& TableReader::array_of(const Value& v, const std::string& name, std::size_t n,
+                                         const std::string& expected) {
+  auto a = v.node->as_array();
+  if (!a) fail(name, v.node, expected, found(v, true));
+  if (n > 0 && a->size() != n)
+    fail(name, v.node, expected,
+         fmt::format("{} ({} {})", found(v, false), a->size(), a->size() == 1 ? "entry" : "entries"));
+  return *a;
+}
+
+std::vector<double> TableReader::reals(const std::string& name, std::size_t n, bool allow_scalar) {
+  Value v = required_value(name);
+  const std::string range = range_phrase(*v.decl);
+  const std::string each = range.empty() ? "" : ", each" + range;
+  std::string expected = fmt::format("an array of {} numbers{}{}", n, each,
+                                     per_axis(n, loader_.dimension()));
+  if (allow_scalar) expected = fmt::format("a number{} or {}", range, expected);
+  if (allow_scalar && !v.node->is_array()) {
+    const double x = number(v, path_of(name), expected);
+    check_range(v, x, path_of(name), fmt::format("a number{}", range));
+    return std::vector<double>(n, x);
+  }
+  const toml::array& a = array_of(v, name, n, expected);
+  std::vector<double> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    Value e{a.get(i), v.is_default, v.decl};
+    const Path p = child(path_of(name), i);
+    const double x = number(e, p, "a number" + range);
+    check_range(e, x, p, "a number" + range);
+    out.push_back(x);
+  }
+  return out;
+}
+
+std::vector<int> TableReader::integers(const std::string& name, std::size_t n, bool allow_scalar) {
+  Value v = required_value(name);
+  const std::string range = range_phrase(*v.decl);
+  const std::string each = range.empty() ? "" : ", each" + range;
+  std::string expected = fmt::format("an array of {} integers{}{}", n, each,
+                                     per_axis(n, loader_.dimension()));
+  if (allow_scalar) expected = fmt::format("an integer{} or {}", range, expected);
+  auto one = [&](const Value& e, const Path& p, const std::string& what) {
+    auto i = e.node->as_integer();
+    if (!i) loader_.fail(p, e.node, what, found(e, true));
+    check_range(e, static_cast<double>(i->get()), p, "an integer" + range);
+    if (i->get() > INT_MAX || i->get() < INT_MIN) loader_.fail(p, e.node, "a 32-bit integer", found(e, false));
+    return static_cast<int>(i->get());
+  };
+  if (allow_scalar && !v.node->is_array())
+    return std::vector<int>(n, one(v, path_of(name), expected));
+  const toml::array& a = array_of(v, name, n, expected);
+  std::vector<int> out;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    out.push_back(one(Value{a.get(i), v.is_default, v.decl}, child(path_of(name), i), "an integer" + range));
+  return out;
+}
+
+std::vector<std::string> TableReader::expressions(const std::string& name, std::size_t n) {
+  Value v = value(name);
+  if (!v.node) return {};
+  const std::string entry = "a number or a non-empty expression string";
+  const std::string expected = fmt::format(
+      "an array of {} entries{}, each a number or an expression string", n,
+      per_axis(n, loader_.dimension()));
+  const toml::array& a = array_of(v, name, n, expected);
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const toml::node* e = a.get(i);
+    const Path p = child(path_of(name), i);
+    if (auto s = e->as_string()) {
+      if (trim(s->get()).empty()) loader_.fail(p, e, entry, "an empty string");
+      out.push_back(s->get());
+    } else if (e->is_number()) {
+      out.push_back(expression_number(number(Value{e, v.is_default, v.decl}, p, entry)));
+    } else {
+      loader_.fail(p, e, entry, typed_text(*e));
+    }
+  }
+  return out;
+}
+
+std::vector<std::vector<double>> TableReader::points(const std::string& name, std::size_t n,
+                                                     std::size_t min_count) {
+  Value v = required_value(name);
+  const std::string expected =
+      fmt::format("an array of at least {} points, each an array of {} numbers", min_count, n);
+  const toml::array& a = array_of(v, name, 0, expected);
+  if (a.size() < min_count)
+    fail(name, v.node, expected, fmt::format("{} ({} points)", node_text(*v.node), a.size()));
+  std::vector<std::vector<double>> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Path p = child(path_of(name), i);
+    const toml::node* e = a.get(i);
+    auto pa = e->as_array();
+    const std::string point = fmt::format("an array of {} numbers", n);
+    if (!pa) loader_.fail(p, e, point, typed_text(*e));
+    if (pa->size() != n)
+      loader_.fail(p, e, point, fmt::format("{} ({} entries)", node_text(*e), pa->size()));
+    std::vector<double> xs;
+    for (std::size_t j = 0; j < n; ++j)
+      xs.push_back(number(Value{pa->get(j), v.is_default, v.decl}, child(p, j), "a number"));
+    out.push_back(std::move(xs));
+  }
+  return out;
+}
+
+// ---- overrides -----------------------------------------------------------------------------
+
+/// "material[0].density" or "material.0.density" -> {"material", "0", "density"}; nullopt when
+/// malformed (empty parts, unbalanced brackets, a non-index in brackets).
+std::optional<Path> split_key(const std::string& text) {
+  Path out;
+  std::string part;
+  bool after_bracket = false;  // just closed "[n]": only '.', '[' or the end may follow
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '.') {
+      if (part.empty() && !after_bracket) return std::nullopt;
+      if (!part.empty()) out.push_back(part);
+      part.clear();
+      after_bracket = false;
+      if (i + 1 == text.size()) return std::nullopt;
+    } else if (c == '[') {
+      if (part.empty() && !after_bracket) return std::nullopt;
+      if (!part.empty()) out.push_back(part);
+      part.clear();
+      const auto close = text.find(']', i);
+      if (close == std::string::npos) return std::nullopt;
+      const std::string index = trim(text.substr(i + 1, close - i - 1));
+      if (!is_index(index)) return std::nullopt;
+      out.push_back(index);
+      i = close;
+      after_bracket = true;
+    } else if (c == ']' || c == ' ' || c == '\t' || c == '"' || c == '\'') {
+      return std::nullopt;
+    } else {
+      if (after_bracket) return std::nullopt;
+      part += c;
+    }
+  }
+  if (!part.empty()) out.push_back(part);
+  else if (!after_bracket) return std::nullopt;
+  return out;
+}
+
+/// The override value: a TOML value if the text is one, else the text as a plain string.
+toml::table parse_override_value(const std::string& text) {
+  try {
+    toml::table t = toml::parse("v = " + text);
+    if (t.size() == 1 && t.contains("v")) return t;
+  } catch (const toml::parse_error&) {
+  }
+  toml::table t;
+  t.insert("v", text);
+  return t;
+}
+
+void Loader::apply_override(toml::table& root, const std::string& text) {
+  const std::string origin = "--set " + text;
+  const std::string syntax =
+      "section.key=value, e.g. method.order=4 or material[0].density=1100";
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) throw InputError(origin, 0, "", syntax, toml_string(text) + " (no '=')");
+  const std::string lhs = trim(text.substr(0, eq));
+  const std::string rhs = trim(text.substr(eq + 1));
+  auto parts = split_key(lhs);
+  if (!parts || parts->size() < 2)
+    throw InputError(origin, 0, "", syntax, fmt::format("key {}", toml_string(lhs)));
+  const Path& p = *parts;
+  auto unknown = [&](std::size_t n_shown, const std::string& expected) {
+    throw InputError(origin, 0, display(Path(p.begin(), p.begin() + n_shown)), expected,
+                     "an undeclared key");
+  };
+
+  const std::string& name = p[0];
+  const auto& sections = section_names();
+  if (std::find(sections.begin(), sections.end(), name) == sections.end())
+    unknown(1, "a section, one of " + join(sections) + did_you_mean(name, sections));
+
+  toml::table* target = nullptr;
+  std::size_t first = 1;  // index in p of the first key inside `target`
+  if (name == "material" || name == "body") {
+    const std::string example = fmt::format("an entry index, as in {0}.0.name or {0}[0].name", name);
+    if (!is_index(p[1])) throw InputError(origin, 0, display(p), example, toml_string(p[1]));
+    if (p.size() < 3) throw InputError(origin, 0, "", syntax, fmt::format("key {}", toml_string(lhs)));
+    toml::array* entries = root.get_as<toml::array>(name);
+    const std::size_t count = entries ? entries->size() : 0;
+    const std::size_t index = p[1].size() > 9 ? SIZE_MAX : std::stoul(p[1]);
+    if (index >= count)
+      throw InputError(origin, 0, display(Path(p.begin(), p.begin() + 2)),
+                       count ? fmt::format("the index of an existing [[{}]] (0..{})", name, count - 1)
+                             : fmt::format("the index of an existing [[{}]] (the input has none)", name),
+                       p[1]);
+    target = entries->get(index)->as_table();
+    if (!target)
+      throw InputError(origin, 0, display(Path(p.begin(), p.begin() + 2)), "a table",
+                       typed_text(*entries->get(index)));
+    first = 2;
+  } else {
+    if (!root.contains(name)) root.insert(name, toml::table{});
+    target = root.get_as<toml::table>(name);
+    if (!target)
+      throw InputError(origin, 0, name, fmt::format("a table [{}] to set a key in", name),
+                       typed_text(*root.get(name)));
+  }
+
+  const Path keys(p.begin() + static_cast<std::ptrdiff_t>(first), p.end());
+  if (name == "constants") {
+    if (keys.size() != 1) unknown(p.size(), "constants.NAME=number");
+  } else {
+    std::vector<KeyDecl> decls = name == "material"
+                                     ? material_keys(target->get_as<std::string>("model")
+                                                         ? target->get_as<std::string>("model")->get()
+                                                         : "")
+                                     : copy_section(name);
+    std::vector<std::string> names;
+    for (const auto& d : decls) names.push_back(d.name);
+    const std::string where = first == 2 ? fmt::format("[[{}]]", name) : fmt::format("[{}]", name);
+    auto d = std::find_if(decls.begin(), decls.end(), [&](const KeyDecl& k) { return k.name == keys[0]; });
+    if (d == decls.end())
+      unknown(first + 1, fmt::format("a key declared for {}{}", where, did_you_mean(keys[0], names)));
+    if (keys.size() > 1) {
+      if (!(name == "body" && keys[0] == "shape") || keys.size() > 3)
+        unknown(p.size(), fmt::format("a key declared for {}", where));
+      std::vector<std::string> kinds;
+      for (const auto& k : body_shape_kinds()) kinds.push_back(k.name);
+      if (std::find(kinds.begin(), kinds.end(), keys[1]) == kinds.end())
+        unknown(first + 2, "a shape kind, one of " + join(kinds) + did_you_mean(keys[1], kinds));
+      if (keys.size() == 3) {
+        std::vector<std::string> params;
+        for (const auto* k : section_keys("body.shape." + keys[1])) params.push_back(k->name);
+        if (std::find(params.begin(), params.end(), keys[2]) == params.end())
+          unknown(p.size(), fmt::format("a parameter of the {} shape, one of {}{}", keys[1],
+                                        join(params), did_you_mean(keys[2], params)));
+      }
+    }
+  }
+
+  toml::table* table = target;
+  for (std::size_t i = 0; i + 1 < keys.size(); ++i) {
+    if (!table->contains(keys[i])) table->insert(keys[i], toml::table{});
+    toml::table* next = table->get_as<toml::table>(keys[i]);
+    if (!next)
+      throw InputError(origin, 0, display(Path(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(first + i + 1))),
+                       "a table to set a key in", typed_text(*table->get(keys[i])));
+    table = next;
+  }
+  toml::table value = parse_override_value(rhs);
+  table->insert_or_assign(keys.back(), std::move(*value.get("v")));
+  overrides_.emplace_back(p, origin);
+}
+
+// ---- sections ------------------------------------------------------------------------------
+
+void Loader::check_top_level(const toml::table& root) const {
+  const auto& sections = section_names();
+  for (const auto& [key, node] : entries_in_file_order(root)) {
+    if (std::find(sections.begin(), sections.end(), key) == sections.end()) {
+      std::string expected;
+      // A key written above its section header, e.g. `dimension = 2` before [simulation].
+      for (const auto& d : declared_keys())
+        if (d.name == key && d.section.find('.') == std::string::npos && expected.empty())
+          expected = fmt::format("a section, one of {} ('{}' belongs in [{}])", join(sections), key,
+                                 d.section);
+      if (expected.empty())
+        expected = "a section, one of " + join(sections) + did_you_mean(key, sections);
+      fail({key}, node, expected, node->is_table() ? "an unknown table" : "an undeclared key");
+    }
+    if (key == "material" || key == "body") {
+      const auto* a = node->as_array();
+      const bool tables = a && std::all_of(a->begin(), a->end(), [](const toml::node& n) { return n.is_table(); });
+      if (!tables)
+        fail({key}, node, fmt::format("an array of tables, written [[{}]]", key),
+             node->is_table() ? fmt::format("a single table [{}]", key) : typed_text(*node));
+    } else if (!node->is_table()) {
+      fail({key}, node, fmt::format("a table, written [{}]", key), typed_text(*node));
+    }
+  }
+}
+
+void Loader::read_simulation(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "simulation"), {"simulation"}, copy_section("simulation"),
+                "[simulation]");
+  r.reject_unknown_keys();
+  auto& s = cfg.simulation;
+  s.title = r.string("title");
+  s.dimension = dim_ = r.small_integer("dimension");
+  const Mode by_dimension[3] = {Mode::uniaxial_strain_1d, Mode::plane_strain, Mode::three_d};
+  s.mode = by_dimension[dim_ - 1];
+  if (r.present("mode")) {
+    const std::string m = r.string("mode");
+    const Mode modes[4] = {Mode::plane_strain, Mode::plane_stress, Mode::three_d, Mode::uniaxial_strain_1d};
+    for (Mode candidate : modes)
+      if (mode_name(candidate) == m) s.mode = candidate;
+    const bool consistent = (dim_ == 1 && s.mode == Mode::uniaxial_strain_1d) ||
+                            (dim_ == 2 && (s.mode == Mode::plane_strain || s.mode == Mode::plane_stress)) ||
+                            (dim_ == 3 && s.mode == Mode::three_d);
+    if (!consistent) {
+      const char* valid[3] = {"uniaxial", "plane_strain or plane_stress", "3d"};
+      r.fail("mode", r.given("mode"), fmt::format("{} for dimension {}", valid[dim_ - 1], dim_),
+             toml_string(m));
+    }
+  }
+  s.end_time = r.real("end_time");
+  s.cfl = r.real("cfl");
+  s.fixed_dt = r.real("dt");
+  s.max_steps = r.integer("max_steps");
+  s.thickness = r.real("thickness");
+  s.threads = r.small_integer("threads");
+}
+
+void Loader::read_grid(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "grid"), {"grid"}, copy_section("grid"), "[grid]");
+  r.reject_unknown_keys();
+  const auto n = static_cast<std::size_t>(dim_);
+  auto& g = cfg.grid;
+  g.origin = r.reals("origin", n, false);
+  g.extent = r.reals("extent", n, false);
+  g.cell_size = r.reals("cell_size", n, true);
+  for (std::size_t a = 0; a < n; ++a) {
+    const double cells = g.extent[a] / g.cell_size[a];
+    const double whole = std::round(cells);
+    if (whole < 1.0 || std::abs(cells - whole) > ratio_tolerance * cells)
+      r.fail("cell_size", r.given("cell_size"),
+             fmt::format("grid.extent / grid.cell_size to be a whole number of cells on axis {} "
+                         "(within {} relative)",
+                         "xyz"[a], ratio_tolerance),
+             fmt::format("{} / {} = {:.12g}", real_text(g.extent[a]), real_text(g.cell_size[a]), cells));
+  }
+}
+
+void Loader::read_method(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "method"), {"method"}, copy_section("method"), "[method]");
+  r.reject_unknown_keys();
+  auto& m = cfg.method;
+  m.shape = r.string("shape");
+  m.update = r.string("update");
+  m.order = r.small_integer("order");
+  m.stress_update = r.string("stress_update");
+  m.smoothing_length = r.real("smoothing_length");
+}
+
+void Loader::read_constants(const toml::table& root, Config& cfg) {
+  const toml::table* t = section(root, "constants");
+  if (!t) return;
+  const std::vector<std::string> reserved{"x", "y", "z", "X", "Y", "Z", "t", "_pi", "_e"};
+  for (const auto& [name, node] : entries_in_file_order(*t)) {
+    const Path p{"constants", name};
+    if (!is_identifier(name))
+      fail(p, node, "a constant name that is an identifier (letters, digits, _; not starting with a digit)",
+           toml_string(name));
+    if (std::find(reserved.begin(), reserved.end(), name) != reserved.end())
+      fail(p, node, "a constant name other than " + join(reserved) + " (built into expressions)",
+           toml_string(name));
+    double x = 0.0;
+    if (auto i = node->as_integer()) x = static_cast<double>(i->get());
+    else if (auto f = node->as_floating_point()) x = f->get();
+    else fail(p, node, "a number", typed_text(*node));
+    if (!std::isfinite(x)) fail(p, node, "a finite number", node_text(*node));
+    cfg.constants.emplace_back(name, x);
+  }
+}
+
+void Loader::read_materials(const toml::table& root, Config& cfg) {
+  const toml::array* entries = root.get_as<toml::array>("material");
+  if (!entries) return;
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* t = entries->get(i)->as_table();
+    const Path path = child(Path{"material"}, i);
+    // The model decides which keys the table may have, so it is read first.
+    TableReader common(*this, t, path, copy_section("material"), "[[material]]");
+    const std::string model = common.string("model");
+    TableReader r(*this, t, path, material_keys(model),
+                  fmt::format("[[material]] with model '{}'", model));
+    r.reject_unknown_keys();
+
+    MaterialConfig m;
+    m.name = r.string("name");
+    if (m.name.empty()) r.fail("name", r.given("name"), "a non-empty name", "\"\"");
+    for (const auto& other : cfg.materials)
+      if (other.name == m.name)
+        r.fail("name", r.given("name"),
+               fmt::format("a name not used by another [[material]] (used at {})", other.where.str()),
+               toml_string(m.name));
+    m.model = model;
+    m.numbers["density"] = r.real("density");
+    m.where = {file_, line_of(t)};
+
+    const auto info = material_model_info().find(model);
+    std::vector<std::string> given_keys;
+    if (info != material_model_info().end()) {
+      for (const auto& d : info->second.keys) {
+        if (r.present(d.name))
+          given_keys.push_back(fmt::format("{} = {}", d.name, node_text(*r.given(d.name))));
+        if (!r.present(d.name) && d.default_value.empty()) {
+          if (d.required)
+            r.fail(d.name, nullptr, expected_value_text(d) + " (required key)", "nothing");
+          continue;
+        }
+        switch (d.type) {
+          case KeyType::real: m.numbers[d.name] = r.real(d.name); break;
+          case KeyType::integer: m.numbers[d.name] = static_cast<double>(r.integer(d.name)); break;
+          case KeyType::boolean: m.numbers[d.name] = r.boolean(d.name) ? 1.0 : 0.0; break;
+          case KeyType::string: m.strings[d.name] = r.string(d.name); break;
+          default:
+            throw std::logic_error(fmt::format(
+                "material model '{}' declares key '{}' of a type a [[material]] cannot hold", model,
+                d.name));
+        }
+      }
+      if (info->second.check) {
+        const std::string problem = info->second.check(m);
+        if (!problem.empty())
+          fail(path, t, problem,
+               fmt::format("model '{}' with {}", model,
+                           given_keys.empty() ? "none of its own keys" : join(given_keys)));
+      }
+    }
+    cfg.materials.push_back(std::move(m));
+  }
+}
+
+BodyShapeConfig Loader::read_shape(TableReader& body) {
+  const toml::node* node = body.given("shape");
+  if (!node) body.fail("shape", nullptr, "an inline table with one shape kind (required key)", "nothing");
+  std::vector<std::string> kinds;
+  for (const auto& k : body_shape_kinds()) kinds.push_back(k.name);
+  const std::string example = "e.g. { box = { min = [...], max = [...] } }";
+  const toml::table* t = node->as_table();
+  if (!t) body.fail("shape", node, "an inline table with one shape kind, " + example, typed_text(*node));
+  if (t->size() != 1) {
+    std::vector<std::string> given;
+    for (auto&& [k, v] : *t) given.emplace_back(k.str());
+    body.fail("shape", node, "exactly one shape kind, one of " + join(kinds),
+              given.empty() ? "an empty table" : fmt::format("{} kinds: {}", given.size(), join(given)));
+  }
+  std::string kind;
+  const toml::node* params = nullptr;
+  for (auto&& [k, v] : *t) {
+    kind = std::string(k.str());
+    params = &v;
+  }
+  const Path path = body.path_of("shape");
+  auto info = std::find_if(body_shape_kinds().begin(), body_shape_kinds().end(),
+                           [&](const BodyShapeKind& k) { return k.name == kind; });
+  if (info == body_shape_kinds().end())
+    fail(child(path, kind), params, "a shape kind, one of " + join(kinds) + did_you_mean(kind, kinds),
+         toml_string(kind));
+  if (!info->valid_in[dim_ - 1]) {
+    std::vector<std::string> valid;
+    for (const auto& k : body_shape_kinds())
+      if (k.valid_in[dim_ - 1]) valid.push_back(k.name);
+    fail(child(path, kind), params, fmt::format("a shape kind valid in {}D, one of {}", dim_, join(valid)),
+         toml_string(kind));
+  }
+  if (!params->is_table())
+    fail(child(path, kind), params, fmt::format("a table of the {} parameters", kind), typed_text(*params));
+
+  TableReader r(*this, params->as_table(), child(path, kind), copy_section("body.shape." + kind),
+                fmt::format("a {} shape", kind));
+  r.reject_unknown_keys();
+  const auto n = static_cast<std::size_t>(dim_);
+  BodyShapeConfig s;
+  s.kind = kind;
+  if (kind == "box") {
+    s.min = r.reals("min", n, false);
+    s.max = r.reals("max", n, false);
+    for (std::size_t a = 0; a < n; ++a)
+      if (!(s.max[a] > s.min[a]))
+        r.fail("max", r.given("max"), fmt::format("max > min on every axis"),
+               fmt::format("max {} <= min {} on axis {}", real_text(s.max[a]), real_text(s.min[a]), "xyz"[a]));
+  } else if (kind == "circle" || kind == "sphere") {
+    s.center = r.reals("center", n, false);
+    s.radius = r.real("radius");
+  } else if (kind == "ellipse") {
+    s.center = r.reals("center", n, false);
+    s.semi_axes = r.reals("semi_axes", n, false);
+  } else if (kind == "annulus") {
+    s.center = r.reals("center", n, false);
+    s.inner_radius = r.real("inner_radius");
+    s.outer_radius = r.real("outer_radius");
+    if (!(s.inner_radius < s.outer_radius))
+      r.fail("inner_radius", r.given("inner_radius"), "inner_radius < outer_radius",
+             fmt::format("inner_radius = {}, outer_radius = {}", real_text(s.inner_radius),
+                         real_text(s.outer_radius)));
+  } else if (kind == "polygon") {
+    s.vertices = r.points("vertices", 2, 3);
+    double twice_area = 0.0;
+    for (std::size_t i = 0; i < s.vertices.size(); ++i) {
+      const auto& a = s.vertices[i];
+      const auto& b = s.vertices[(i + 1) % s.vertices.size()];
+      twice_area += a[0] * b[1] - b[0] * a[1];
+    }
+    if (twice_area == 0.0)
+      r.fail("vertices", r.given("vertices"), "vertices enclosing a non-zero area", "zero area");
+  } else {
+    throw std::logic_error("input: shape kind '" + kind + "' declared but not read");
+  }
+  return s;
+}
+
+void Loader::read_bodies(const toml::table& root, Config& cfg) {
+  const toml::array* entries = root.get_as<toml::array>("body");
+  if (!entries || entries->empty())
+    fail({"body"}, nullptr, "at least one [[body]] table", "none");
+  std::vector<std::string> material_names;
+  for (const auto& m : cfg.materials) material_names.push_back(m.name);
+  const auto n = static_cast<std::size_t>(dim_);
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* t = entries->get(i)->as_table();
+    TableReader r(*this, t, child(Path{"body"}, i), copy_section("body"), "[[body]]");
+    r.reject_unknown_keys();
+    BodyConfig b;
+    b.name = r.present("name") ? r.string("name") : fmt::format("body{}", i);
+    if (b.name.empty()) r.fail("name", r.given("name"), "a non-empty name", "\"\"");
+    for (const auto& other : cfg.bodies)
+      if (other.name == b.name)
+        r.fail("name", r.given("name"),
+               fmt::format("a name not used by another [[body]] (used at {})", other.where.str()),
+               toml_string(b.name));
+    b.material = r.string("material");
+    if (std::find(material_names.begin(), material_names.end(), b.material) == material_names.end())
+      r.fail("material", r.given("material"),
+             material_names.empty()
+                 ? std::string("the name of a [[material]] (the input has none)")
+                 : "the name of a [[material]], one of " + join(material_names) +
+                       did_you_mean(b.material, material_names),
+             toml_string(b.material));
+    b.shape = read_shape(r);
+    b.particles_per_cell = r.integers("particles_per_cell", n, true);
+    b.velocity = r.expressions("velocity", n);
+    if (b.velocity.empty()) b.velocity.assign(n, "0");
+    b.displacement = r.expressions("displacement", n);
+    b.where = {file_, line_of(t)};
+    cfg.bodies.push_back(std::move(b));
+  }
+}
+
+void Loader::read_boundary(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "boundary"), {"boundary"}, copy_section("boundary"),
+                "[boundary]");
+  r.reject_unknown_keys();
+  std::vector<std::string> valid;
+  for (int f = 0; f < 2 * dim_; ++f) valid.push_back(face_names[f]);
+  for (int f = 0; f < 6; ++f) {
+    if (f >= 2 * dim_) {
+      if (r.present(face_names[f]))
+        r.fail(face_names[f], r.given(face_names[f]),
+               fmt::format("a face of the {}D grid, one of {}", dim_, join(valid)),
+               fmt::format("{} (a {}D grid has no {} axis)", face_names[f], dim_, "xyz"[f / 2]));
+      continue;
+    }
+    const std::string c = r.string(face_names[f]);
+    for (int k = 0; k < 4; ++k)
+      if (c == face_condition_names[k]) cfg.boundary.face[f] = static_cast<FaceCondition>(k);
+  }
+  for (int a = 0; a < dim_; ++a) {
+    const bool lo = cfg.boundary.face[2 * a] == FaceCondition::periodic;
+    const bool hi = cfg.boundary.face[2 * a + 1] == FaceCondition::periodic;
+    if (lo != hi) {
+      const int f = lo ? 2 * a : 2 * a + 1;
+      const auto text = [&](int face) {
+        return fmt::format("{} = \"{}\"", face_names[face],
+                           face_condition_names[static_cast<int>(cfg.boundary.face[face])]);
+      };
+      r.fail(face_names[f], r.given(face_names[f]),
+             fmt::format("periodic on both {} faces ({} and {})", "xyz"[a], face_names[2 * a],
+                         face_names[2 * a + 1]),
+             text(2 * a) + ", " + text(2 * a + 1));
+    }
+  }
+}
+
+void Loader::read_body_force(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "body_force"), {"body_force"}, copy_section("body_force"),
+                "[body_force]");
+  r.reject_unknown_keys();
+  cfg.body_force.expression = r.expressions("expression", static_cast<std::size_t>(dim_));
+}
+
+void Loader::read_output(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "output"), {"output"}, copy_section("output"), "[output]");
+  r.reject_unknown_keys();
+  auto& o = cfg.output;
+  o.directory = r.string("directory");
+  if (o.directory.empty()) {
+    std::string stem = std::filesystem::path(file_).stem().string();
+    o.directory = "out/" + (stem.empty() ? std::string("input") : stem);
+  }
+  o.every = r.real("every");
+  o.history_every = r.real("history_every");
+  o.checkpoint_every = r.real("checkpoint_every");
+  o.snapshots = r.boolean("snapshots");
+  o.grid_snapshots = r.boolean("grid_snapshots");
+  o.checkpoints = r.boolean("checkpoints");
+}
+
+Config Loader::load(toml::table& root, const std::vector<std::string>& overrides) {
+  for (const auto& o : overrides) apply_override(root, o);
+  check_top_level(root);
+  Config cfg;
+  cfg.source_file = file_;
+  read_simulation(root, cfg);
+  read_grid(root, cfg);
+  read_method(root, cfg);
+  read_constants(root, cfg);
+  read_materials(root, cfg);
+  read_bodies(root, cfg);
+  read_boundary(root, cfg);
+  read_body_force(root, cfg);
+  read_output(root, cfg);
+  cfg.resolved_toml = config_to_toml(cfg);
+  return cfg;
+}
+
+// ---- writing -------------------------------------------------------------------------------
+
+template <class T, class F>
+std::string array_text(const std::vector<T>& values, F&& text) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) out += (i ? ", " : "") + text(values[i]);
+  return out + "]";
+}
+
+std::string reals_text(const std::vector<double>& v) { return array_text(v, real_text); }
+
+/// An expression entry: as a number when reading that number back gives the same text.
+std::string expression_text(const std::string& e) {
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(e.data(), e.data() + e.size(), v);
+  if (ec == std::errc() && end == e.data() + e.size() && std::isfinite(v) && expression_number(v) == e)
+    return real_text(v);
+  return toml_string(e);
+}
+
+std::string shape_text(const BodyShapeConfig& s) {
+  std::string params;
+  if (s.kind == "box") params = fmt::format("min = {}, max = {}", reals_text(s.min), reals_text(s.max));
+  else if (s.kind == "circle" || s.kind == "sphere")
+    params = fmt::format("center = {}, radius = {}", reals_text(s.center), real_text(s.radius));
+  else if (s.kind == "ellipse")
+    params = fmt::format("center = {}, semi_axes = {}", reals_text(s.center), reals_text(s.semi_axes));
+  else if (s.kind == "annulus")
+    params = fmt::format("center = {}, inner_radius = {}, outer_radius = {}", reals_text(s.center),
+                         real_text(s.inner_radius), real_text(s.outer_radius));
+  else if (s.kind == "polygon")
+    params = "vertices = " + array_text(s.vertices, reals_text);
+  return fmt::format("{{ {} = {{ {} }} }}", toml_key(s.kind), params);
+}
+
+}  // namespace
+
+std::string config_to_toml(const Config& c) {
+  std::string o;
+  auto line = [&](const std::string& key, const std::string& value) {
+    o += fmt::format("{} = {}\n", toml_key(key), value);
+  };
+  auto boolean = [](bool b) { return std::string(b ? "true" : "false"); };
+  const auto& s = c.simulation;
+  o += "[simulation]\n";
+  line("title", toml_string(s.title));
+  line("dimension", fmt::format("{}", s.dimension));
+  line("mode", toml_string(mode_name(s.mode)));
+  line("end_time", real_text(s.end_time));
+  line("cfl", real_text(s.cfl));
+  line("dt", real_text(s.fixed_dt));
+  line("max_steps", fmt::format("{}", s.max_steps));
+  line("thickness", real_text(s.thickness));
+  line("threads", fmt::format("{}", s.threads));
+
+  o += "\n[grid]\n";
+  line("origin", reals_text(c.grid.origin));
+  line("extent", reals_text(c.grid.extent));
+  line("cell_size", reals_text(c.grid.cell_size));
+
+  const auto& m = c.method;
+  o += "\n[method]\n";
+  line("shape", toml_string(m.shape));
+  line("update", toml_string(m.update));
+  line("order", fmt::format("{}", m.order));
+  line("stress_update", toml_string(m.stress_update));
+  line("smoothing_length", real_text(m.smoothing_length));
+
+  if (!c.constants.empty()) {
+    o += "\n[constants]\n";
+    for (const auto& [name, value] : c.constants) line(name, real_text(value));
+  }
+
+  for (const auto& mat : c.materials) {
+    o += "\n[[material]]\n";
+    line("name", toml_string(mat.name));
+    line("model", toml_string(mat.model));
+    line("density", real_text(mat.number("density")));
+    auto info = material_model_info().find(mat.model);
+    if (info == material_model_info().end()) continue;
+    for (const auto& d : info->second.keys) {
+      if (d.type == KeyType::string) {
+        if (auto it = mat.strings.find(d.name); it != mat.strings.end()) line(d.name, toml_string(it->second));
+        continue;
+      }
+      auto it = mat.numbers.find(d.name);
+      if (it == mat.numbers.end()) continue;
+      if (d.type == KeyType::integer) line(d.name, fmt::format("{}", static_cast<long long>(it->second)));
+      else if (d.type == KeyType::boolean) line(d.name, boolean(it->second != 0.0));
+      else line(d.name, real_text(it->second));
+    }
+  }
+
+  for (const auto& b : c.bodies) {
+    o += "\n[[body]]\n";
+    line("name", toml_string(b.name));
+    line("material", toml_string(b.material));
+    line("shape", shape_text(b.shape));
+    line("particles_per_cell", array_text(b.particles_per_cell, [](int n) { return fmt::format("{}", n); }));
+    line("velocity", array_text(b.velocity, expression_text));
+    if (!b.displacement.empty()) line("displacement", array_text(b.displacement, expression_text));
+  }
+
+  o += "\n[boundary]\n";
+  for (int f = 0; f < 2 * s.dimension && f < 6; ++f)
+    line(face_names[f], toml_string(face_condition_names[static_cast<int>(c.boundary.face[f])]));
+
+  if (!c.body_force.expression.empty()) {
+    o += "\n[body_force]\n";
+    line("expression", array_text(c.body_force.expression, expression_text));
+  }
+
+  const auto& out = c.output;
+  o += "\n[output]\n";
+  line("directory", toml_string(out.directory));
+  line("every", real_text(out.every));
+  line("history_every", real_text(out.history_every));
+  line("checkpoint_every", real_text(out.checkpoint_every));
+  line("snapshots", boolean(out.snapshots));
+  line("grid_snapshots", boolean(out.grid_snapshots));
+  line("checkpoints", boolean(out.checkpoints));
+  return o;
+}
+
+Config load_config_string(const std::string& toml_text, const std::string& name,
+                          const std::vector<std::string>& overrides) {
+  const std::string file = name.empty() ? std::string("<input>") : name;
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(file, static_cast<int>(e.source().begin.line), "", "valid TOML",
+                     std::string(e.description()));
+  }
+  Loader loader(file);
+  Config cfg = loader.load(root, overrides);
+  cfg.source_file = name;
+  return cfg;
+}
+
+Config load_config(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, 0, "", "a readable input file", std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return load_config_string(text.str(), path, overrides);
+}
+
+}  // namespace cairn

@@ -1,0 +1,672 @@
+// The single list of input-key declarations, and the key reference generated from it
+// (`cairn keys`, docs/input.md).
+#include "cairn/io/schema.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <map>
+
+#include "cairn/materials/material.hpp"
+#include "cairn/sim/names.hpp"
+
+namespace cairn {
+
+namespace {
+
+std::vector<std::string> face_conditions() { return {"free", "fixed", "symmetry", "periodic"}; }
+std::vector<std::string> mode_names() { return {"plane_strain", "plane_stress", "3d", "uniaxial"}; }
+
+/// Fluent construction of a KeyDecl (designated initializers that skip members warn under -Wextra).
+class Key {
+ public:
+  Key(std::string section, std::string name, KeyType type, std::string doc) {
+    decl_.section = std::move(section);
+    decl_.name = std::move(name);
+    decl_.type = type;
+    decl_.doc = std::move(doc);
+  }
+  Key& by_default(std::string toml_text) {
+    decl_.default_value = std::move(toml_text);
+    return *this;
+  }
+  Key& required() {
+    decl_.required = true;
+    return *this;
+  }
+  Key& min(double v) {
+    decl_.min = v;
+    return *this;
+  }
+  Key& max(double v) {
+    decl_.max = v;
+    return *this;
+  }
+  Key& choices(std::function<std::vector<std::string>()> f) {
+    decl_.choices = std::move(f);
+    return *this;
+  }
+  operator KeyDecl() const { return decl_; }  // NOLINT(google-explicit-constructor)
+
+ private:
+  KeyDecl decl_;
+};
+
+std::vector<KeyDecl> make_declarations() {
+  using T = KeyType;
+  std::vector<KeyDecl> k;
+  // [simulation]
+  k.push_back(Key("simulation", "title", T::string,
+                 "Free-text title, copied into the output metadata.")
+                .by_default("\"\""));
+  k.push_back(Key("simulation", "dimension", T::integer,
+                 "Spatial dimension D of the grid, the particles and every vector key.")
+                .required()
+                .min(1)
+                .max(3));
+  k.push_back(Key("simulation", "mode", T::string,
+                 "Out-of-plane kinematics; must match the dimension: uniaxial (strain) in 1D, "
+                 "plane_strain or plane_stress in 2D, 3d in 3D.")
+                .choices(mode_names));
+  k.push_back(Key("simulation", "end_time", T::real,
+                 "Simulated time at which the run stops.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("simulation", "cfl", T::real,
+                 "Courant number: dt = cfl * h_min / (c_max + max|v|).")
+                .by_default("0.5")
+                .min(above_zero)
+                .max(2.0));
+  k.push_back(Key("simulation", "dt", T::real,
+                 "Fixed time step; 0 = use the CFL rule.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("simulation", "max_steps", T::integer,
+                 "Stop after this many steps; 0 = no limit.")
+                .by_default("0")
+                .min(0));
+  k.push_back(Key("simulation", "thickness", T::real,
+                 "Out-of-plane thickness in 2D, cross-section area in 1D; unused in 3D.")
+                .by_default("1.0")
+                .min(above_zero));
+  k.push_back(Key("simulation", "threads", T::integer,
+                 "OpenMP threads; 0 = the OpenMP default.")
+                .by_default("0")
+                .min(0));
+
+  // [grid]
+  k.push_back(Key("grid", "origin", T::real_array,
+                 "Lower corner of the grid, one coordinate per axis.")
+                .required());
+  k.push_back(Key("grid", "extent", T::real_array,
+                 "Size of the grid along each axis.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("grid", "cell_size", T::real_array,
+                 "Cell size, one value for every axis or one per axis; extent / cell_size "
+                 "must be a whole number of cells on every axis.")
+                .required()
+                .min(above_zero));
+
+  // [method]
+  k.push_back(Key("method", "shape", T::string,
+                 "Shape-function (basis) family.")
+                .by_default("\"bspline2\"")
+                .choices(shape_family_names));
+  k.push_back(Key("method", "update", T::string,
+                 "Particle velocity and position update scheme.")
+                .by_default("\"flip\"")
+                .choices(update_scheme_names));
+  k.push_back(Key("method", "order", T::integer,
+                 "Order k of FMPM(k) and XPIC(k); unused by other updates.")
+                .by_default("1")
+                .min(1)
+                .max(64));
+  k.push_back(Key("method", "stress_update", T::string,
+                 "When in the step the stress is updated.")
+                .by_default("\"usl\"")
+                .choices(stress_update_names));
+  k.push_back(Key("method", "smoothing_length", T::real,
+                 "uGIMP half-width l; 0 = the initial particle size.")
+                .by_default("0.0")
+                .min(0.0));
+
+  // [[material]] (the model's own keys come from material_model_info())
+  k.push_back(Key("material", "name", T::string,
+                 "Unique name, referenced by [[body]] material.")
+                .required());
+  k.push_back(Key("material", "model", T::string,
+                 "Constitutive model.")
+                .required()
+                .choices(material_model_names));
+  k.push_back(Key("material", "density", T::real,
+                 "Reference mass density rho_0.")
+                .required()
+                .min(above_zero));
+
+  // [[body]]
+  k.push_back(Key("body", "name", T::string,
+                 "Unique name used in output; default body<N> for the N-th [[body]] (from 0)."));
+  k.push_back(Key("body", "material", T::string,
+                 "Name of a [[material]].")
+                .required());
+  k.push_back(Key("body", "shape", T::table,
+                 "Region filled with particles: an inline table with exactly one shape kind.")
+                .required());
+  k.push_back(Key("body", "particles_per_cell", T::integer_array,
+                 "Particles per cell along each axis, one value for every axis or one per axis.")
+                .by_default("2")
+                .min(1)
+                .max(16));
+  k.push_back(Key("body", "velocity", T::expression_array,
+                 "Initial velocity, one entry per axis: numbers or expressions in X, Y, Z "
+                 "(reference position) and [constants]; default zeros."));
+  k.push_back(Key("body", "displacement", T::expression_array,
+                 "Initial displacement field, entries as for velocity (F is set from its "
+                 "gradient); default none."));
+
+  // [[body]] shape kinds
+  k.push_back(Key("body.shape.box", "min", T::real_array,
+                 "Lower corner, one coordinate per axis.")
+                .required());
+  k.push_back(Key("body.shape.box", "max", T::real_array,
+                 "Upper corner, one coordinate per axis, each above min.")
+                .required());
+  k.push_back(Key("body.shape.circle", "center", T::real_array,
+                 "Centre [x, y].")
+                .required());
+  k.push_back(Key("body.shape.circle", "radius", T::real,
+                 "Radius.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.ellipse", "center", T::real_array,
+                 "Centre, one coordinate per axis.")
+                .required());
+  k.push_back(Key("body.shape.ellipse", "semi_axes", T::real_array,
+                 "Semi-axes along x, y (and z), one per axis.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.annulus", "center", T::real_array,
+                 "Centre [x, y].")
+                .required());
+  k.push_back(Key("body.shape.annulus", "inner_radius", T::real,
+                 "Inner radius, below outer_radius.")
+                .required()
+                .min(0.0));
+  k.push_back(Key("body.shape.annulus", "outer_radius", T::real,
+                 "Outer radius.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.polygon", "vertices", T::real_array,
+                 "At least 3 vertices [[x, y], ...] in order around a simple polygon.")
+                .required());
+  k.push_back(Key("body.shape.sphere", "center", T::real_array,
+                 "Centre [x, y, z].")
+                .required());
+  k.push_back(Key("body.shape.sphere", "radius", T::real,
+                 "Radius.")
+                .required()
+                .min(above_zero));
+
+  // [boundary]
+  const char* faces[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+  for (int i = 0; i < 6; ++i) {
+    const std::string axis(1, faces[i][0]);
+    const std::string side = i % 2 == 0 ? "lower" : "upper";
+    std::string doc = fmt::format("Condition on the {} {} face of the grid.", side, axis);
+    if (i >= 2) doc += fmt::format(" Only when dimension >= {}.", i / 2 + 1);
+    k.push_back(Key("boundary", faces[i], T::string,
+                 doc)
+                .by_default("\"free\"")
+                .choices(face_conditions));
+  }
+
+  // [body_force]
+  k.push_back(Key("body_force", "expression", T::expression_array,
+                 "Body force per unit mass, one entry per axis: numbers or expressions in "
+                 "x, y, z (current position), X, Y, Z (reference position), t and "
+                 "[constants]; default none."));
+
+  // [output]
+  k.push_back(Key("output", "directory", T::string,
+                 "Output folder; \"\" = out/<input file stem>.")
+                .by_default("\"\""));
+  k.push_back(Key("output", "every", T::real,
+                 "Snapshot interval in simulated time; 0 = first and last only.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("output", "history_every", T::real,
+                 "History (energies, probes) interval; 0 = same as every.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("output", "checkpoint_every", T::real,
+                 "Checkpoint interval; 0 = only at the end.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("output", "snapshots", T::boolean,
+                 "Write HDF5/XDMF particle snapshots.")
+                .by_default("true"));
+  k.push_back(Key("output", "grid_snapshots", T::boolean,
+                 "Also write grid node fields.")
+                .by_default("false"));
+  k.push_back(Key("output", "checkpoints", T::boolean,
+                 "Write checkpoints for `cairn restart`.")
+                .by_default("true"));
+  return k;
+}
+
+/// Computed defaults, shown instead of the (empty) TOML default.
+const std::map<std::string, std::string>& computed_defaults() {
+  static const std::map<std::string, std::string> m{
+      {"simulation.mode", "by dimension"},
+      {"body.name", "body<N>"},
+      {"body.velocity", "zeros"},
+  };
+  return m;
+}
+
+/// Type names that "real[D]"-style generic text would get wrong.
+const std::map<std::string, std::string>& type_overrides() {
+  static const std::map<std::string, std::string> m{
+      {"grid.cell_size", "real or real[D]"},
+      {"body.particles_per_cell", "integer or integer[D]"},
+      {"body.shape", "inline table"},
+      {"body.shape.circle.center", "real[2]"},
+      {"body.shape.annulus.center", "real[2]"},
+      {"body.shape.sphere.center", "real[3]"},
+      {"body.shape.polygon.vertices", "real[2][n]"},
+  };
+  return m;
+}
+
+std::string number_text(double v) { return v == above_zero ? "0" : fmt::format("{}", v); }
+
+std::string join(const std::vector<std::string>& items, const std::string& sep) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
+  return out;
+}
+
+bool is_numeric(KeyType t) {
+  return t == KeyType::integer || t == KeyType::real || t == KeyType::integer_array ||
+         t == KeyType::real_array;
+}
+bool is_integer(KeyType t) { return t == KeyType::integer || t == KeyType::integer_array; }
+
+}  // namespace
+
+std::string range_phrase(const KeyDecl& d) {
+  if (!is_numeric(d.type)) return "";
+  const bool positive = d.min && *d.min == above_zero;
+  if (d.min && d.max) {
+    if (positive) return fmt::format(" in (0, {}]", number_text(*d.max));
+    if (is_integer(d.type)) return fmt::format(" in {}..{}", number_text(*d.min), number_text(*d.max));
+    return fmt::format(" in [{}, {}]", number_text(*d.min), number_text(*d.max));
+  }
+  if (d.min) return positive ? " > 0" : fmt::format(" >= {}", number_text(*d.min));
+  if (d.max) return fmt::format(" <= {}", number_text(*d.max));
+  return "";
+}
+
+namespace {
+
+// ---- documentation text ------------------------------------------------------------------
+
+struct SectionDoc {
+  std::string name;     ///< "simulation"
+  std::string heading;  ///< "[simulation]" or "[[material]]"
+  std::string intro;
+  std::string example;
+};
+
+const std::vector<SectionDoc>& section_docs() {
+  static const std::vector<SectionDoc> docs{
+      {"simulation", "[simulation]",
+       "What is simulated and for how long: dimension, kinematic mode, end time and time-step "
+       "control. Required.",
+       "[simulation]\n"
+       "title = \"two blocks\"\n"
+       "dimension = 2\n"
+       "mode = \"plane_strain\"\n"
+       "end_time = 2.0e-3\n"
+       "cfl = 0.5\n"},
+      {"grid", "[grid]",
+       "The regular background grid. Every array has D entries. Required.",
+       "[grid]\n"
+       "origin = [0.0, 0.0]\n"
+       "extent = [0.12, 0.04]\n"
+       "cell_size = 1.0e-3   # or [1.0e-3, 1.0e-3]\n"},
+      {"method", "[method]",
+       "The numerical method: shape functions, particle update and stress-update timing. The "
+       "choices are the names registered in this build.",
+       "[method]\n"
+       "shape = \"bspline2\"\n"
+       "update = \"fmpm\"\n"
+       "order = 4\n"
+       "stress_update = \"usl\"\n"},
+      {"constants", "[constants]",
+       "A free table of named numbers usable in every expression (body velocity, displacement, "
+       "body force). Names must be identifiers other than x, y, z, X, Y, Z, t, _pi and _e.",
+       "[constants]\n"
+       "A = 0.05\n"
+       "omega = 1.2e3\n"},
+      {"material", "[[material]]",
+       "One table per material. Besides name, model and density, each model has keys of its own, "
+       "listed below; a model may also require a particular combination of them (e.g. exactly two "
+       "elastic constants).",
+       "[[material]]\n"
+       "name = \"rubber\"\n"
+       "model = \"neo_hookean\"\n"
+       "density = 1500.0\n"
+       "# ... the model's own keys\n"},
+      {"body", "[[body]]",
+       "One table per body: a region of the grid filled with particles of one material. At "
+       "least one is required.",
+       "[[body]]\n"
+       "name = \"left\"\n"
+       "material = \"rubber\"\n"
+       "shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] } }\n"
+       "particles_per_cell = 2\n"
+       "velocity = [8.165, 0.0]\n"
+       "\n"
+       "[[body]]\n"
+       "material = \"rubber\"\n"
+       "shape = { circle = { center = [0.09, 0.02], radius = 0.01 } }\n"
+       "displacement = [\"A*sin(2*_pi*X)\", \"0\"]\n"},
+      {"boundary", "[boundary]",
+       "Conditions on the faces of the grid. A periodic axis needs periodic on both of its faces; "
+       "y_* and z_* keys exist only in 2D and 3D, z_* only in 3D.",
+       "[boundary]\n"
+       "x_min = \"fixed\"\n"
+       "x_max = \"free\"\n"
+       "y_min = \"symmetry\"\n"},
+      {"body_force", "[body_force]",
+       "A body force per unit mass (e.g. gravity), applied to every particle.",
+       "[body_force]\n"
+       "expression = [0.0, \"-9.81\"]\n"},
+      {"output", "[output]",
+       "What is written, where and how often.",
+       "[output]\n"
+       "directory = \"out/two_blocks\"\n"
+       "every = 1.0e-4\n"
+       "grid_snapshots = false\n"},
+  };
+  return docs;
+}
+
+std::string md_cell(std::string s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '|') out += "\\|";
+    else out += c;
+  }
+  return out;
+}
+
+std::string md_code(const std::string& s) { return s.empty() ? "" : "`" + s + "`"; }
+
+/// Range or choices for markdown: choices each in backticks.
+std::string md_range(const KeyDecl& d) {
+  if (d.type == KeyType::string && d.choices) {
+    std::vector<std::string> c = d.choices();
+    for (auto& s : c) s = "`" + s + "`";
+    return join(c, ", ");
+  }
+  return md_cell(range_text(d));
+}
+
+/// Default cell: TOML defaults as code, "required" / "none" / computed defaults as text.
+std::string md_default(const KeyDecl& d) {
+  if (d.required || d.default_value.empty()) return md_cell(default_text(d));
+  return md_code(d.default_value);
+}
+
+void md_table(std::string& out, const std::vector<KeyDecl>& keys) {
+  out += "| key | type | default | range / choices | doc |\n";
+  out += "|---|---|---|---|---|\n";
+  for (const auto& d : keys)
+    out += fmt::format("| `{}` | {} | {} | {} | {} |\n", d.name, md_cell(type_text(d)),
+                       md_default(d), md_range(d), md_cell(d.doc));
+}
+
+std::vector<KeyDecl> copy_section(std::string_view section) {
+  std::vector<KeyDecl> out;
+  for (const auto* d : section_keys(section)) out.push_back(*d);
+  return out;
+}
+
+std::string markdown_text() {
+  std::string out;
+  out +=
+      "# Cairn input reference\n"
+      "\n"
+      "<!-- Generated from src/cairn/io/schema.cpp by `cairn keys --markdown > docs/input.md`; "
+      "do not edit by hand. -->\n"
+      "\n"
+      "A Cairn input file is [TOML](https://toml.io). Every key is declared once, with its type, "
+      "default, allowed range or choices and a one-line doc; this page is generated from those "
+      "declarations. Unknown keys, misspelled sections, values of the wrong type or out of "
+      "range are errors that name the file, the line and the key, what was expected and what "
+      "was found.\n"
+      "\n"
+      "- `D` is `simulation.dimension`; `real[D]` is an array with one number per axis.\n"
+      "- Integers are accepted wherever a real is expected.\n"
+      "- `expr[D]` entries are numbers or expression strings such as `\"A*sin(2*_pi*X)\"`; "
+      "they may use the names of `[constants]`. An empty string is an error.\n"
+      "- Any key can be overridden on the command line: `cairn run case.toml --set "
+      "method.order=4 --set material[0].density=1100`. The value is read as a TOML value "
+      "(`--set grid.origin=[0,0]`), or as a plain string when it is not one "
+      "(`--set method.update=fmpm`). Entries of `[[material]]` and `[[body]]` are addressed by "
+      "their index from 0: `material.0.density` or `material[0].density`.\n"
+      "- `cairn check case.toml` validates an input and prints it with every default filled "
+      "in.\n"
+      "\n"
+      "Sections:";
+  for (const auto& s : section_docs()) out += fmt::format(" [{}](#{}) ·", s.heading, s.name);
+  out.pop_back();
+  out.pop_back();
+  out += "\n";
+
+  for (const auto& s : section_docs()) {
+    out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.intro);
+    if (s.name == "constants") {
+      out += "| key | type | default | range / choices | doc |\n";
+      out += "|---|---|---|---|---|\n";
+      out += "| *any identifier* | real | none |  | A named number for expressions. |\n";
+    } else {
+      md_table(out, copy_section(s.name));
+    }
+    out += fmt::format("\n```toml\n{}```\n", s.example);
+
+    if (s.name == "material") {
+      for (const auto& model : material_model_names()) {
+        out += fmt::format("\n### model `{}`\n\n", model);
+        auto it = material_model_info().find(model);
+        if (it == material_model_info().end() || it->second.keys.empty()) {
+          if (it != material_model_info().end() && !it->second.doc.empty())
+            out += it->second.doc + "\n\n";
+          out += "No keys of its own.\n";
+          continue;
+        }
+        if (!it->second.doc.empty()) out += it->second.doc + "\n\n";
+        md_table(out, it->second.keys);
+      }
+    }
+    if (s.name == "body") {
+      out +=
+          "\n### shape kinds\n\n"
+          "`shape` holds exactly one of these kinds, each an inline table of its parameters "
+          "(all required).\n\n"
+          "| kind | dimensions | doc |\n|---|---|---|\n";
+      for (const auto& kind : body_shape_kinds()) {
+        std::vector<std::string> dims;
+        for (int d = 0; d < 3; ++d)
+          if (kind.valid_in[d]) dims.push_back(fmt::format("{}D", d + 1));
+        out += fmt::format("| `{}` | {} | {} |\n", kind.name, join(dims, ", "), md_cell(kind.doc));
+      }
+      out += "\n";
+      std::vector<KeyDecl> params;
+      for (const auto& kind : body_shape_kinds())
+        for (auto d : copy_section("body.shape." + kind.name)) {
+          d.name = kind.name + "." + d.name;
+          params.push_back(d);
+        }
+      md_table(out, params);
+    }
+  }
+  return out;
+}
+
+/// One aligned block of rows (columns separated by two spaces, the last column not padded).
+void plain_rows(std::string& out, const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& r : rows)
+    for (std::size_t c = 0; c < r.size(); ++c) {
+      if (width.size() <= c) width.push_back(0);
+      width[c] = std::max(width[c], r[c].size());
+    }
+  for (const auto& r : rows) {
+    std::string line = "  ";
+    for (std::size_t c = 0; c < r.size(); ++c)
+      line += c + 1 < r.size() ? fmt::format("{:<{}}  ", r[c], width[c]) : r[c];
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+}
+
+std::vector<std::vector<std::string>> plain_table(const std::vector<KeyDecl>& keys) {
+  std::vector<std::vector<std::string>> rows{{"key", "type", "default", "range/choices", "doc"}};
+  for (const auto& d : keys)
+    rows.push_back({d.name, type_text(d), default_text(d), range_text(d), d.doc});
+  return rows;
+}
+
+std::string plain_text() {
+  std::string out =
+      "Cairn input keys (D = simulation.dimension). Override any key with "
+      "--set section.key=value;\n"
+      "[[material]] and [[body]] entries by index: --set material.0.density=1100.\n";
+  for (const auto& s : section_docs()) {
+    out += fmt::format("\n{}\n", s.heading);
+    if (s.name == "constants") {
+      plain_rows(out, {{"key", "type", "doc"}, {"<identifier>", "real", "A named number for expressions."}});
+      continue;
+    }
+    plain_rows(out, plain_table(copy_section(s.name)));
+    if (s.name == "material") {
+      for (const auto& model : material_model_names()) {
+        out += fmt::format("\n[[material]] model = \"{}\"\n", model);
+        auto it = material_model_info().find(model);
+        if (it == material_model_info().end() || it->second.keys.empty()) {
+          out += "  (no keys of its own)\n";
+          continue;
+        }
+        plain_rows(out, plain_table(it->second.keys));
+      }
+    }
+    if (s.name == "body") {
+      for (const auto& kind : body_shape_kinds()) {
+        out += fmt::format("\n[[body]] shape = {{ {} = {{ ... }} }}: {}\n", kind.name, kind.doc);
+        plain_rows(out, plain_table(copy_section("body.shape." + kind.name)));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<KeyDecl>& declared_keys() {
+  static const std::vector<KeyDecl> keys = make_declarations();
+  return keys;
+}
+
+std::vector<const KeyDecl*> section_keys(std::string_view section) {
+  std::vector<const KeyDecl*> out;
+  for (const auto& d : declared_keys())
+    if (d.section == section) out.push_back(&d);
+  return out;
+}
+
+const std::vector<std::string>& section_names() {
+  static const std::vector<std::string> names{"simulation", "grid",     "method",
+                                              "constants",  "material", "body",
+                                              "boundary",   "body_force", "output"};
+  return names;
+}
+
+const std::vector<BodyShapeKind>& body_shape_kinds() {
+  static const std::vector<BodyShapeKind> kinds{
+      {"box", {true, true, true}, "Axis-aligned box (a segment in 1D, a rectangle in 2D)."},
+      {"circle", {false, true, false}, "Disc."},
+      {"ellipse", {false, true, true}, "Axis-aligned ellipse (2D) or ellipsoid (3D)."},
+      {"annulus", {false, true, false}, "Ring between two concentric circles."},
+      {"polygon", {false, true, false}, "Simple polygon."},
+      {"sphere", {false, false, true}, "Ball."},
+  };
+  return kinds;
+}
+
+std::vector<KeyDecl> material_keys(const std::string& model) {
+  std::vector<KeyDecl> out = copy_section("material");
+  auto it = material_model_info().find(model);
+  if (it != material_model_info().end())
+    for (KeyDecl d : it->second.keys) {
+      d.section = "material";
+      out.push_back(std::move(d));
+    }
+  return out;
+}
+
+std::string expected_value_text(const KeyDecl& d) {
+  const std::string range = range_phrase(d);
+  switch (d.type) {
+    case KeyType::boolean: return "true or false";
+    case KeyType::integer: return "an integer" + range;
+    case KeyType::real: return "a number" + range;
+    case KeyType::string:
+      if (d.choices) return "one of " + join(d.choices(), ", ");
+      return "a string";
+    case KeyType::integer_array: return "an array of integers" + (range.empty() ? "" : ", each" + range);
+    case KeyType::real_array: return "an array of numbers" + (range.empty() ? "" : ", each" + range);
+    case KeyType::expression_array: return "an array of numbers or expression strings";
+    case KeyType::string_array: return "an array of strings";
+    case KeyType::table: return "a table";
+  }
+  return "a value";
+}
+
+std::string type_text(const KeyDecl& d) {
+  auto it = type_overrides().find(d.section + "." + d.name);
+  if (it != type_overrides().end()) return it->second;
+  switch (d.type) {
+    case KeyType::boolean: return "boolean";
+    case KeyType::integer: return "integer";
+    case KeyType::real: return "real";
+    case KeyType::string: return "string";
+    case KeyType::integer_array: return "integer[D]";
+    case KeyType::real_array: return "real[D]";
+    case KeyType::expression_array: return "expr[D]";
+    case KeyType::string_array: return "string[]";
+    case KeyType::table: return "table";
+  }
+  return "?";
+}
+
+std::string range_text(const KeyDecl& d) {
+  if (d.type == KeyType::string && d.choices) return join(d.choices(), ", ");
+  std::string r = range_phrase(d);
+  if (r.rfind(" in ", 0) == 0) return r.substr(4);
+  return r.empty() ? "" : r.substr(1);
+}
+
+std::string default_text(const KeyDecl& d) {
+  if (d.required) return "required";
+  auto it = computed_defaults().find(d.section + "." + d.name);
+  if (it != computed_defaults().end()) return it->second;
+  return d.default_value.empty() ? "none" : d.default_value;
+}
+
+std::string keys_text(bool markdown) { return markdown ? markdown_text() : plain_text(); }
+
+}  // namespace cairn

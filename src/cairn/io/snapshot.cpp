@@ -1,0 +1,332 @@
+#include "cairn/io/snapshot.hpp"
+
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <system_error>
+
+#include "cairn/io/atomic_file.hpp"
+#include "cairn/io/hdf5_util.hpp"
+
+namespace cairn {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Escape the XML special characters of a text used in an attribute value or element body.
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::size_t>& dims) {
+  std::string s;
+  for (std::size_t i = 0; i < dims.size(); ++i) s += (i > 0 ? " " : "") + std::to_string(dims[i]);
+  return s;
+}
+
+/// Append an HDF DataItem referencing `file`:`dataset`.
+void hdf_item(fmt::memory_buffer& out, const std::string& indent, const std::string& dims,
+              bool integer, const std::string& file, const std::string& dataset) {
+  fmt::format_to(std::back_inserter(out),
+                 "{}<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">"
+                 "snapshots/{}:{}</DataItem>\n",
+                 indent, dims, integer ? "Int" : "Float", integer ? 4 : 8, xml_escape(file),
+                 dataset);
+}
+
+void attribute(fmt::memory_buffer& out, const std::string& name, const char* type,
+               const std::string& dims, bool integer, const std::string& file,
+               const std::string& dataset) {
+  fmt::format_to(std::back_inserter(out),
+                 "        <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n", name, type);
+  hdf_item(out, "          ", dims, integer, file, dataset);
+  out.append(std::string_view("        </Attribute>\n"));
+}
+
+const char* xdmf_header() {
+  return "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+         "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+         "  <Domain>\n";
+}
+
+}  // namespace
+
+template <int D>
+SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem)
+    : directory_(std::move(directory)), stem_(std::move(stem)) {
+  if (stem_.empty()) throw std::invalid_argument("snapshot file stem must not be empty");
+}
+
+template <int D>
+void SnapshotWriter<D>::set_next_index(int index) {
+  if (index < 0) throw std::invalid_argument("snapshot index must be >= 0");
+  next_index_ = index;
+}
+
+template <int D>
+void SnapshotWriter<D>::set_entries(std::vector<Entry> entries) {
+  entries_ = std::move(entries);
+  info_.clear();
+}
+
+template <int D>
+fs::path SnapshotWriter<D>::snapshot_path(int index) const {
+  return directory_ / "snapshots" / fmt::format("{}-{:06d}.h5", stem_, index);
+}
+
+template <int D>
+fs::path SnapshotWriter<D>::particles_xdmf_path() const {
+  return directory_ / (stem_ + ".xdmf");
+}
+
+template <int D>
+fs::path SnapshotWriter<D>::grid_xdmf_path() const {
+  return directory_ / (stem_ == "particles" ? std::string("grid.xdmf") : stem_ + "-grid.xdmf");
+}
+
+template <int D>
+void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long long step,
+                              const Grid<D>* grid, const NodeField<D>* nodes) {
+  const std::size_t n = particles.n();
+  const bool with_grid = grid != nullptr && nodes != nullptr;
+  if (particles.reference_position.size() != n || particles.velocity.size() != n ||
+      particles.mass.size() != n || particles.volume0.size() != n ||
+      particles.deformation_gradient.size() != n || particles.kirchhoff_stress.size() != n ||
+      particles.material.size() != n || particles.body.size() != n) {
+    throw std::invalid_argument("snapshot: particle arrays have inconsistent lengths");
+  }
+  if (with_grid) {
+    const auto nn = static_cast<std::size_t>(grid->n_nodes());
+    if (nodes->mass.size() != nn || nodes->velocity_new.size() != nn) {
+      throw std::invalid_argument(fmt::format(
+          "snapshot: node field has {} nodes but the grid has {}", nodes->mass.size(), nn));
+    }
+  }
+
+  // Derived particle quantities.
+  std::vector<double> position(3 * n, 0.0), velocity(3 * n, 0.0), displacement(3 * n, 0.0);
+  std::vector<double> volume(n), stress(6 * n), deformation(9 * n), pressure(n), von_mises(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    for (int a = 0; a < D; ++a) {
+      position[3 * p + a] = particles.position[p][a];
+      velocity[3 * p + a] = particles.velocity[p][a];
+      displacement[3 * p + a] = particles.position[p][a] - particles.reference_position[p][a];
+    }
+    const Mat3& F = particles.deformation_gradient[p];
+    const double J = F.determinant();
+    volume[p] = J * particles.volume0[p];
+    const Mat3 sigma = particles.kirchhoff_stress[p] / J;
+    const double sxx = sigma(0, 0), syy = sigma(1, 1), szz = sigma(2, 2);
+    const double syz = 0.5 * (sigma(1, 2) + sigma(2, 1));
+    const double sxz = 0.5 * (sigma(0, 2) + sigma(2, 0));
+    const double sxy = 0.5 * (sigma(0, 1) + sigma(1, 0));
+    const double voigt[6] = {sxx, syy, szz, syz, sxz, sxy};
+    for (int k = 0; k < 6; ++k) stress[6 * p + k] = voigt[k];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) deformation[9 * p + 3 * i + j] = F(i, j);
+    pressure[p] = -(sxx + syy + szz) / 3.0;
+    von_mises[p] = std::sqrt(0.5 * ((sxx - syy) * (sxx - syy) + (syy - szz) * (syy - szz) +
+                                    (szz - sxx) * (szz - sxx)) +
+                             3.0 * (syz * syz + sxz * sxz + sxy * sxy));
+  }
+
+  // Grid node data, stored array order (x fastest) and shape slowest axis first.
+  FileInfo file_info;
+  file_info.readable = true;
+  file_info.n_particles = n;
+  std::vector<double> node_mass, node_velocity;
+  if (with_grid) {
+    file_info.has_grid = true;
+    file_info.origin.assign(3, 0.0);
+    file_info.spacing.assign(3, 1.0);
+    const Vec<D> first = grid->node_position(0);
+    for (int a = 0; a < D; ++a) {
+      file_info.origin[a] = first[a];
+      file_info.spacing[a] = grid->cell_size()[a];
+    }
+    if (D == 1) file_info.node_shape.push_back(1);
+    for (int a = D - 1; a >= 0; --a) {
+      file_info.node_shape.push_back(static_cast<std::size_t>(grid->stored_nodes(a)));
+    }
+    const auto nn = static_cast<std::size_t>(grid->n_nodes());
+    node_mass = nodes->mass;
+    node_velocity.assign(3 * nn, 0.0);
+    for (std::size_t i = 0; i < nn; ++i) {
+      for (int a = 0; a < D; ++a) node_velocity[3 * i + a] = nodes->velocity_new[i][a];
+    }
+  }
+
+  const fs::path target = snapshot_path(next_index_);
+  write_file_atomically(target, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp);
+    const hid_t root = file.get();
+    h5::write_string_attribute(root, "format", "cairn-snapshot");
+    h5::write_double_attribute(root, "time", time);
+    h5::write_int64_attribute(root, "step", step);
+    h5::write_int64_attribute(root, "dimension", D);
+    {
+      h5::Handle g = h5::create_group(root, "particles");
+      const hid_t gid = g.get();
+      h5::write_doubles(gid, "position", position.data(), n, 3);
+      h5::write_doubles(gid, "velocity", velocity.data(), n, 3);
+      h5::write_doubles(gid, "displacement", displacement.data(), n, 3);
+      h5::write_doubles(gid, "mass", particles.mass.data(), n);
+      h5::write_doubles(gid, "volume", volume.data(), n);
+      h5::write_doubles(gid, "stress", stress.data(), n, 6);
+      h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9);
+      h5::write_doubles(gid, "pressure", pressure.data(), n);
+      h5::write_doubles(gid, "von_mises", von_mises.data(), n);
+      h5::write_ints(gid, "material", particles.material.data(), n);
+      h5::write_ints(gid, "body", particles.body.data(), n);
+    }
+    if (with_grid) {
+      h5::Handle g = h5::create_group(root, "grid");
+      const hid_t gid = g.get();
+      h5::write_doubles_shaped(gid, "node_mass", node_mass.data(), file_info.node_shape);
+      std::vector<std::size_t> vshape = file_info.node_shape;
+      vshape.push_back(3);
+      h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape);
+      h5::write_doubles_attribute(gid, "origin", file_info.origin);
+      h5::write_doubles_attribute(gid, "spacing", file_info.spacing);
+    }
+  });
+
+  const std::string name = target.filename().string();
+  info_[name] = file_info;
+  bool replaced = false;
+  for (auto& entry : entries_) {
+    if (entry.second == name) {
+      entry.first = time;
+      replaced = true;
+    }
+  }
+  if (!replaced) entries_.emplace_back(time, name);
+  ++next_index_;
+  write_xdmf();
+}
+
+template <int D>
+const typename SnapshotWriter<D>::FileInfo& SnapshotWriter<D>::info(const std::string& file) {
+  auto it = info_.find(file);
+  if (it != info_.end()) return it->second;
+  FileInfo fi;
+  const fs::path path = directory_ / "snapshots" / file;
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) {
+    try {
+      h5::Handle f = h5::open_file(path);
+      h5::Handle g = h5::open_group(f.get(), "particles");
+      const std::vector<std::size_t> shape = h5::dataset_shape(g.get(), "mass");
+      if (shape.size() == 1) {
+        fi.n_particles = shape[0];
+        fi.readable = true;
+      }
+      if (h5::has_child(f.get(), "grid")) {
+        h5::Handle grid = h5::open_group(f.get(), "grid");
+        fi.node_shape = h5::dataset_shape(grid.get(), "node_mass");
+        fi.origin = h5::read_doubles_attribute(grid.get(), "origin");
+        fi.spacing = h5::read_doubles_attribute(grid.get(), "spacing");
+        fi.has_grid = fi.origin.size() == 3 && fi.spacing.size() == 3;
+      }
+    } catch (const std::runtime_error&) {
+      fi = FileInfo{};  // unreadable: left out of the XDMF listing
+    }
+  }
+  return info_[file] = fi;
+}
+
+template <int D>
+void SnapshotWriter<D>::write_xdmf() {
+  fmt::memory_buffer parts, grids;
+  bool any_grid = false;
+  parts.append(std::string_view(xdmf_header()));
+  parts.append(std::string_view(
+      "    <!-- stress: Cauchy stress in Voigt order xx, yy, zz, yz, xz, xy; "
+      "deformation_gradient: F row-major -->\n"));
+  fmt::format_to(std::back_inserter(parts),
+                 "    <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+                 xml_escape(stem_));
+  grids.append(std::string_view(xdmf_header()));
+  grids.append(std::string_view(
+      "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n"));
+
+  for (const auto& [time, file] : entries_) {
+    const FileInfo& fi = info(file);
+    if (!fi.readable) continue;
+    const std::string n = std::to_string(fi.n_particles);
+    const std::string grid_name = xml_escape(fs::path(file).stem().string());
+    fmt::format_to(std::back_inserter(parts),
+                   "      <Grid Name=\"{}\" GridType=\"Uniform\">\n"
+                   "        <Time Value=\"{:.17g}\"/>\n"
+                   "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
+                   "NodesPerElement=\"1\"/>\n"
+                   "        <Geometry GeometryType=\"XYZ\">\n",
+                   grid_name, time, n);
+    hdf_item(parts, "          ", n + " 3", false, file, "/particles/position");
+    parts.append(std::string_view("        </Geometry>\n"));
+    attribute(parts, "velocity", "Vector", n + " 3", false, file, "/particles/velocity");
+    attribute(parts, "displacement", "Vector", n + " 3", false, file, "/particles/displacement");
+    attribute(parts, "mass", "Scalar", n, false, file, "/particles/mass");
+    attribute(parts, "volume", "Scalar", n, false, file, "/particles/volume");
+    attribute(parts, "stress", "Matrix", n + " 6", false, file, "/particles/stress");
+    attribute(parts, "deformation_gradient", "Tensor", n + " 9", false, file,
+              "/particles/deformation_gradient");
+    attribute(parts, "pressure", "Scalar", n, false, file, "/particles/pressure");
+    attribute(parts, "von_mises", "Scalar", n, false, file, "/particles/von_mises");
+    attribute(parts, "material", "Scalar", n, true, file, "/particles/material");
+    attribute(parts, "body", "Scalar", n, true, file, "/particles/body");
+    parts.append(std::string_view("      </Grid>\n"));
+
+    if (!fi.has_grid) continue;
+    any_grid = true;
+    const bool three = fi.node_shape.size() == 3;
+    const std::string dims = join(fi.node_shape);
+    // CoRectMesh origin and spacing are listed slowest axis first (z y x), like Dimensions.
+    const std::string origin = three ? fmt::format("{:.17g} {:.17g} {:.17g}", fi.origin[2], fi.origin[1], fi.origin[0])
+                                     : fmt::format("{:.17g} {:.17g}", fi.origin[1], fi.origin[0]);
+    const std::string spacing = three ? fmt::format("{:.17g} {:.17g} {:.17g}", fi.spacing[2], fi.spacing[1], fi.spacing[0])
+                                      : fmt::format("{:.17g} {:.17g}", fi.spacing[1], fi.spacing[0]);
+    const int rank = three ? 3 : 2;
+    fmt::format_to(std::back_inserter(grids),
+                   "      <Grid Name=\"{}\" GridType=\"Uniform\">\n"
+                   "        <Time Value=\"{:.17g}\"/>\n"
+                   "        <Topology TopologyType=\"{}DCoRectMesh\" Dimensions=\"{}\"/>\n"
+                   "        <Geometry GeometryType=\"{}\">\n"
+                   "          <DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" "
+                   "Format=\"XML\">{}</DataItem>\n"
+                   "          <DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" "
+                   "Format=\"XML\">{}</DataItem>\n"
+                   "        </Geometry>\n",
+                   grid_name, time, rank, dims, three ? "ORIGIN_DXDYDZ" : "ORIGIN_DXDY", rank,
+                   origin, rank, spacing);
+    attribute(grids, "node_mass", "Scalar", dims, false, file, "/grid/node_mass");
+    attribute(grids, "node_velocity", "Vector", dims + " 3", false, file, "/grid/node_velocity");
+    grids.append(std::string_view("      </Grid>\n"));
+  }
+  const std::string_view footer("    </Grid>\n  </Domain>\n</Xdmf>\n");
+  parts.append(footer);
+  grids.append(footer);
+  write_text_atomically(particles_xdmf_path(), fmt::to_string(parts));
+  if (any_grid) write_text_atomically(grid_xdmf_path(), fmt::to_string(grids));
+}
+
+template class SnapshotWriter<1>;
+template class SnapshotWriter<2>;
+template class SnapshotWriter<3>;
+
+}  // namespace cairn

@@ -1,0 +1,95 @@
+// Particle (and optionally grid) snapshots in HDF5 with XDMF 3 index files for ParaView/VisIt.
+//
+// Layout under the output directory:
+//   snapshots/<stem>-NNNNNN.h5   one file per write() (NNNNNN = running index, 6 digits)
+//   <stem>.xdmf                  temporal collection of the particle data of all snapshots
+//   grid.xdmf                    temporal collection of node data (only if grids were written;
+//                                named <stem>-grid.xdmf when stem is not "particles")
+// Every file is written atomically (see atomic_file.hpp).
+//
+// Snapshot file contents (n particles, always padded to 3 space components):
+//   root attributes: time (double), step (int64), dimension (int64), format = "cairn-snapshot"
+//   /particles/position, velocity, displacement (= x - X)      n x 3
+//   /particles/mass, volume (= det F * volume0), pressure (= -tr(sigma)/3), von_mises   n
+//   /particles/stress                Cauchy sigma = tau / det F, n x 6, Voigt order xx,yy,zz,yz,xz,xy
+//   /particles/deformation_gradient  n x 9, row-major (F00, F01, F02, F10, ...)
+//   /particles/material, body        int32, n
+//   /grid (optional): node_mass (shape [nz,] [ny,] nx; in 1D 1 x nx) and node_velocity (same
+//     shape x 3), over all stored nodes including ghost layers, x fastest; attributes origin and
+//     spacing (position of stored node 0 and the cell size, x y z, padded with 0 and 1).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
+
+namespace cairn {
+
+/// Writes numbered HDF5 snapshots of the particles (and optionally the grid) and keeps the XDMF
+/// index files up to date. Its listing state (entries(), next_index()) can be checkpointed so a
+/// restarted run continues the same series.
+template <int D>
+class SnapshotWriter {
+ public:
+  /// One listed snapshot: (time, file name relative to <directory>/snapshots).
+  using Entry = std::pair<double, std::string>;
+
+  /// Snapshots go to `directory`/snapshots, index files to `directory`. Nothing is written
+  /// until the first write().
+  explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles");
+
+  /// Write snapshot number next_index() of `particles` at `time`/`step` and rewrite the XDMF
+  /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
+  /// (node_velocity is NodeField::velocity_new, the grid velocity after the last update).
+  /// Throws std::runtime_error on I/O failure, std::invalid_argument on inconsistent sizes.
+  void write(const Particles<D>& particles, double time, long long step,
+             const Grid<D>* grid = nullptr, const NodeField<D>* nodes = nullptr);
+
+  /// Index the next write() uses in its file name.
+  [[nodiscard]] int next_index() const { return next_index_; }
+  /// Set the index of the next snapshot file (restart). Throws std::invalid_argument if < 0.
+  void set_next_index(int index);
+
+  /// The snapshots listed in the XDMF files, in order of writing.
+  [[nodiscard]] std::vector<Entry> entries() const { return entries_; }
+  /// Replace the listing (restart from a checkpoint). The XDMF files are rewritten at the next
+  /// write(); listed files that no longer exist are then left out of the XDMF.
+  void set_entries(std::vector<Entry> entries);
+
+  /// Path of the snapshot file with the given index.
+  [[nodiscard]] std::filesystem::path snapshot_path(int index) const;
+  /// Path of the particle XDMF file (<directory>/<stem>.xdmf).
+  [[nodiscard]] std::filesystem::path particles_xdmf_path() const;
+  /// Path of the grid XDMF file (<directory>/grid.xdmf for the default stem).
+  [[nodiscard]] std::filesystem::path grid_xdmf_path() const;
+
+ private:
+  /// What the XDMF needs to know about one snapshot file.
+  struct FileInfo {
+    bool readable = false;
+    std::size_t n_particles = 0;
+    bool has_grid = false;
+    std::vector<std::size_t> node_shape;  ///< grid node array shape, slowest axis first
+    std::vector<double> origin, spacing;  ///< x y z
+  };
+
+  const FileInfo& info(const std::string& file);
+  void write_xdmf();
+
+  std::filesystem::path directory_;
+  std::string stem_;
+  int next_index_ = 0;
+  std::vector<Entry> entries_;
+  std::map<std::string, FileInfo> info_;
+};
+
+extern template class SnapshotWriter<1>;
+extern template class SnapshotWriter<2>;
+extern template class SnapshotWriter<3>;
+
+}  // namespace cairn

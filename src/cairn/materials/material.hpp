@@ -1,0 +1,87 @@
+// Constitutive models behind one narrow interface.
+//
+// A model turns a deformation gradient (and, for path-dependent laws, its state variables, the
+// velocity gradient and the time step) into a Kirchhoff stress and a strain energy. Models are
+// created by name from the material registry; each declares its own input keys, which the input
+// validator uses for the [[material]] tables.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cairn/io/config.hpp"
+#include "cairn/io/keys.hpp"
+#include "cairn/math/types.hpp"
+#include "cairn/util/registry.hpp"
+
+namespace cairn {
+
+/// What a stress update sees of one particle.
+struct MaterialPoint {
+  const Mat3& F;       ///< deformation gradient after this step's increment
+  const Mat3& L;       ///< velocity gradient of this step (3x3)
+  double* state;       ///< the particle's state variables (model-defined length)
+  double dt;
+};
+
+class Material {
+ public:
+  explicit Material(const MaterialConfig& cfg) : name_(cfg.name), density_(cfg.number("density")) {}
+  virtual ~Material() = default;
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] double density() const { return density_; }  ///< reference density rho_0
+  /// Number of state variables per particle (0 for hyperelastic laws).
+  [[nodiscard]] virtual int n_state() const { return 0; }
+
+  /// Kirchhoff stress tau = J sigma for the deformation gradient F (3x3, full 3D).
+  [[nodiscard]] virtual Mat3 kirchhoff(const Mat3& F) const = 0;
+  /// Strain energy per unit reference volume W(F).
+  [[nodiscard]] virtual double energy_density(const Mat3& F) const = 0;
+  /// Speed of the fastest wave at deformation F, used by the CFL time step.
+  [[nodiscard]] virtual double wave_speed(const Mat3& F) const = 0;
+
+  /// General stress update; hyperelastic laws need only kirchhoff(). Path-dependent models
+  /// override this and keep their history in point.state.
+  virtual Mat3 update(const MaterialPoint& point) const { return kirchhoff(point.F); }
+
+ private:
+  std::string name_;
+  double density_;
+};
+
+/// Registry entry data beyond the factory: the model's own keys (besides name, model, density).
+struct MaterialModelInfo {
+  std::string doc;
+  std::vector<KeyDecl> keys;
+  /// Extra cross-key validation (e.g. "give exactly two elastic constants"); returns an error
+  /// message or "" when fine.
+  std::string (*check)(const MaterialConfig&) = nullptr;
+};
+
+using MaterialRegistry = Registry<Material, const MaterialConfig&>;
+
+/// Declared keys and doc per model name (filled by the registration lines).
+std::map<std::string, MaterialModelInfo>& material_model_info();
+
+/// Create a material from a validated config (throws UnknownName for an unknown model).
+std::unique_ptr<Material> make_material(const MaterialConfig& cfg);
+
+/// Registration helper: `CAIRN_REGISTER_MATERIAL(NeoHookean, "neo_hookean", info)`.
+struct MaterialRegistration {
+  MaterialRegistration(const std::string& name, MaterialModelInfo info,
+                       MaterialRegistry::Factory factory) {
+    material_model_info()[name] = info;
+    MaterialRegistry::instance().add(name, info.doc, std::move(factory));
+  }
+};
+
+#define CAIRN_REGISTER_MATERIAL(Class, key, info)                                          \
+  static const ::cairn::MaterialRegistration cairn_material_registration_##Class(          \
+      key, info, [](const ::cairn::MaterialConfig& c) -> std::unique_ptr<::cairn::Material> { \
+        return std::make_unique<Class>(c);                                                 \
+      })
+
+}  // namespace cairn

@@ -1,0 +1,54 @@
+// Shape-function families. A family fills the transfer cache with each particle's stencil
+// (node indices, S_pi and G_pi) once per step; every transfer then reads the cache. Adding a
+// family is one file with a class and one CAIRN_REGISTER_SHAPE line.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/io/config.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/transfer/cache.hpp"
+#include "cairn/util/registry.hpp"
+
+namespace cairn {
+
+/// What a family may read when it is created.
+struct ShapeContext {
+  const MethodConfig& method;
+  int dimension;
+};
+
+template <int D>
+class ShapeFamily {
+ public:
+  virtual ~ShapeFamily() = default;
+  /// Ghost node layers the family needs beyond each non-periodic domain face.
+  [[nodiscard]] virtual int ghost_layers() const = 0;
+  /// Fill cache.node/weight/gradient/count/cell and reach for every particle. Throws
+  /// SimulationFailure naming the lowest-index particle whose stencil leaves the stored grid.
+  virtual void build(const Grid<D>& grid, const Particles<D>& particles,
+                     TransferCache<D>& cache) const = 0;
+};
+
+template <int D>
+using ShapeRegistry = Registry<ShapeFamily<D>, const ShapeContext&>;
+
+template <int D>
+std::unique_ptr<ShapeFamily<D>> make_shape_family(const ShapeContext& ctx) {
+  return ShapeRegistry<D>::instance().create("shape family", ctx.method.shape, ctx);
+}
+
+/// One registration line per family: registers the class template for D = 1, 2, 3.
+#define CAIRN_REGISTER_SHAPE(Class, key, doc)                                                  \
+  static const bool cairn_shape_registered_##Class =                                           \
+      (::cairn::ShapeRegistry<1>::instance().add(                                              \
+           key, doc, [](const ::cairn::ShapeContext& c) { return std::make_unique<Class<1>>(c); }), \
+       ::cairn::ShapeRegistry<2>::instance().add(                                              \
+           key, doc, [](const ::cairn::ShapeContext& c) { return std::make_unique<Class<2>>(c); }), \
+       ::cairn::ShapeRegistry<3>::instance().add(                                              \
+           key, doc, [](const ::cairn::ShapeContext& c) { return std::make_unique<Class<3>>(c); }), \
+       true)
+
+}  // namespace cairn

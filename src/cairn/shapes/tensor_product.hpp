@@ -1,0 +1,111 @@
+// Shared builder for tensor-product families (seed 003 Eq. 18): S_pi = prod_a phi(x_a),
+// G_pi[a] = phi'(x_a) prod_{b != a} phi(x_b) / h_a. A family supplies only its 1D kernel:
+//
+//   struct Kernel {
+//     int width(const Particles<D>&) const;      // max nodes per axis for this step
+//     // first node and per-axis values at particle p, axis a; xi is the position in cell units
+//     int eval(const Particles<D>&, std::size_t p, int a, double xi, double* w, double* dw) const;
+//   };
+//
+// eval() returns the first node's multi-index along the axis and fills width() weights and
+// derivatives (derivative with respect to xi, i.e. per cell).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+
+#include "cairn/shapes/shape_family.hpp"
+#include "cairn/util/failure.hpp"
+
+namespace cairn {
+
+template <int D, class Kernel>
+void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Particles<D>& particles,
+                          TransferCache<D>& cache) {
+  constexpr int max_width = 8;
+  const int width = kernel.width(particles);
+  int slots = 1;
+  for (int a = 0; a < D; ++a) slots *= width;
+  const auto n = particles.n();
+  cache.reserve(n, slots);
+  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+
+  std::int64_t first_bad = INT64_MAX;
+  IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+#pragma omp parallel
+  {
+    IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
+    std::int64_t bad_t = INT64_MAX;
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
+      std::array<std::array<double, max_width>, D> w{}, dw{};
+      IVec<D> first;
+      const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      IVec<D> cell;
+      for (int a = 0; a < D; ++a) {
+        cell[a] = static_cast<int>(std::floor(xi[a]));
+        first[a] = kernel.eval(particles, p, a, xi[a], w[a].data(), dw[a].data());
+        lo_t[a] = std::max(lo_t[a], cell[a] - first[a]);
+        hi_t[a] = std::max(hi_t[a], first[a] + width - 1 - cell[a] - 1);
+      }
+      cache.cell[p] = cell;
+      const std::size_t base = static_cast<std::size_t>(p) * slots;
+      int used = 0;
+      IVec<D> k = IVec<D>::Zero();
+      for (int s = 0; s < slots; ++s) {
+        // k = multi-index of slot s within the width^D box
+        int rem = s;
+        for (int a = 0; a < D; ++a) {
+          k[a] = rem % width;
+          rem /= width;
+        }
+        double S = 1.0;
+        Vec<D> G = Vec<D>::Ones();
+        for (int a = 0; a < D; ++a) {
+          S *= w[a][k[a]];
+          for (int b = 0; b < D; ++b) G[b] *= (a == b) ? dw[a][k[a]] * inv_h[a] : w[a][k[a]];
+        }
+        if (S == 0.0 && G.isZero(0.0)) continue;  // outside the support
+        const std::int32_t idx = grid.node_index(first + k);
+        if (idx < 0) {
+          bad_t = std::min<std::int64_t>(bad_t, p);
+          continue;
+        }
+        cache.node[base + used] = idx;
+        cache.weight[base + used] = S;
+        cache.gradient[base + used] = G;
+        ++used;
+      }
+      cache.count[p] = static_cast<std::uint16_t>(used);
+    }
+#pragma omp critical
+    {
+      first_bad = std::min(first_bad, bad_t);
+      lo = lo.cwiseMax(lo_t);
+      hi = hi.cwiseMax(hi_t);
+    }
+  }
+  cache.reach_lo = lo;
+  cache.reach_hi = hi;
+  if (first_bad != INT64_MAX) {
+    const Vec<D>& x = particles.position[first_bad];
+    std::string where;
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    throw SimulationFailure(first_bad, "position",
+                            "particle " + std::to_string(first_bad) + " left the grid at (" +
+                                where + "): its stencil reaches beyond the ghost nodes");
+  }
+}
+
+/// Hat function N(s) = max(0, 1 - |s|) (seed 003 Eq. 17) and its antiderivative from -inf.
+inline double hat(double s) { return std::max(0.0, 1.0 - std::abs(s)); }
+inline double hat_integral(double s) {
+  if (s <= -1.0) return 0.0;
+  if (s <= 0.0) return 0.5 * (s + 1.0) * (s + 1.0);
+  if (s <= 1.0) return 1.0 - 0.5 * (1.0 - s) * (1.0 - s);
+  return 1.0;
+}
+
+}  // namespace cairn

@@ -1,0 +1,132 @@
+// Particles from the [[body]] tables: a regular lattice of particles_per_cell^D points in every
+// grid cell, kept where the point lies inside the body's shape. Each particle carries the volume
+// of its lattice cell (times the thickness in 2D, the cross-section in 1D), mass rho0 V0 and
+// edge lengths h / ppc. An optional displacement field u(X) places it at x = X + u(X) with
+// F = I + grad u (central differences), and its initial velocity is evaluated at X.
+#include <cmath>
+#include <stdexcept>
+
+#include "cairn/bc/expression.hpp"
+#include "cairn/sim/simulation.hpp"
+
+namespace cairn {
+namespace {
+
+template <int D>
+bool inside(const BodyShapeConfig& s, const Vec<D>& x) {
+  auto vec = [](const std::vector<double>& v) {
+    Vec<D> out = Vec<D>::Zero();
+    for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
+    return out;
+  };
+  if (s.kind == "box") {
+    const Vec<D> lo = vec(s.min), hi = vec(s.max);
+    return (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all();
+  }
+  if (s.kind == "circle" || s.kind == "sphere") return (x - vec(s.center)).norm() <= s.radius;
+  if (s.kind == "ellipse") {
+    const Vec<D> d = (x - vec(s.center)).cwiseQuotient(vec(s.semi_axes));
+    return d.squaredNorm() <= 1.0;
+  }
+  if (s.kind == "annulus") {
+    const double r = (x - vec(s.center)).norm();
+    return r >= s.inner_radius && r <= s.outer_radius;
+  }
+  if (s.kind == "polygon") {
+    if constexpr (D == 2) {
+      bool in = false;  // even-odd crossing rule
+      const auto& v = s.vertices;
+      for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
+        if ((v[i][1] > x[1]) != (v[j][1] > x[1]) &&
+            x[0] < (v[j][0] - v[i][0]) * (x[1] - v[i][1]) / (v[j][1] - v[i][1]) + v[i][0])
+          in = !in;
+      }
+      return in;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+template <int D>
+void create_particles(const Config& config, const Grid<D>& grid,
+                      const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
+                      Particles<D>& particles) {
+  const double thickness = D == 3 ? 1.0 : config.simulation.thickness;
+  for (std::size_t b = 0; b < config.bodies.size(); ++b) {
+    const BodyConfig& body = config.bodies[b];
+    int mat = -1;
+    for (std::size_t m = 0; m < config.materials.size(); ++m)
+      if (config.materials[m].name == body.material) mat = static_cast<int>(m);
+    if (mat < 0)
+      throw std::invalid_argument(body.where.str() + ": body '" + body.name +
+                                  "': unknown material '" + body.material + "'");
+    IVec<D> ppc;
+    for (int a = 0; a < D; ++a) ppc[a] = body.particles_per_cell[a];
+    const Vec<D> lp = grid.cell_size().cwiseQuotient(ppc.template cast<double>());
+    const double vol = lp.prod() * thickness;
+    const double mass = materials[mat]->density() * vol;
+
+    std::unique_ptr<ExpressionVector<D>> velocity, displacement;
+    try {
+      if (!body.velocity.empty())
+        velocity = std::make_unique<ExpressionVector<D>>(body.velocity, config.constants);
+      if (!body.displacement.empty())
+        displacement = std::make_unique<ExpressionVector<D>>(body.displacement, config.constants);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
+    }
+
+    const std::size_t before = particles.n();
+    const IVec<D> n_cells = grid.n_cells();
+    IVec<D> n_points = n_cells.cwiseProduct(ppc);
+    long long total = 1;
+    for (int a = 0; a < D; ++a) total *= n_points[a];
+    for (long long k = 0; k < total; ++k) {
+      long long rem = k;
+      Vec<D> X;
+      for (int a = 0; a < D; ++a) {
+        const long long ia = rem % n_points[a];
+        rem /= n_points[a];
+        X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
+      }
+      if (!inside<D>(body.shape, X)) continue;
+      const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
+      particles.add(X, v0, mass, vol, lp, mat, static_cast<std::int32_t>(b));
+      if (displacement) {
+        const std::size_t p = particles.n() - 1;
+        particles.position[p] = X + (*displacement)(X, X, 0.0);
+        Mat3 F = Mat3::Identity();
+        for (int a = 0; a < D; ++a) {
+          const double h = 1e-6 * grid.cell_size()[a];
+          Vec<D> Xp = X, Xm = X;
+          Xp[a] += h;
+          Xm[a] -= h;
+          const Vec<D> du = ((*displacement)(Xp, Xp, 0.0) - (*displacement)(Xm, Xm, 0.0)) / (2.0 * h);
+          F.col(a).template head<D>() += du;
+        }
+        particles.deformation_gradient[p] = F;
+      }
+    }
+    if (particles.n() == before)
+      throw std::invalid_argument(body.where.str() + ": body '" + body.name +
+                                  "' contains no particle: its shape misses every particle "
+                                  "position of the grid");
+  }
+  // Initial stresses of pre-deformed bodies.
+  for (std::size_t p = 0; p < particles.n(); ++p) {
+    if (particles.deformation_gradient[p].isIdentity(0.0)) continue;
+    const Mat3 L = Mat3::Zero();
+    double* state = nullptr;
+    const MaterialPoint point{particles.deformation_gradient[p], L, state, 0.0};
+    particles.kirchhoff_stress[p] = materials[particles.material[p]]->update(point);
+  }
+  (void)mode;
+}
+
+template void create_particles<1>(const Config&, const Grid<1>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<1>&);
+template void create_particles<2>(const Config&, const Grid<2>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<2>&);
+template void create_particles<3>(const Config&, const Grid<3>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<3>&);
+
+}  // namespace cairn

@@ -1,0 +1,79 @@
+#include <algorithm>
+
+#include "cairn/transfer/transfer.hpp"
+
+namespace cairn {
+
+template <int D>
+void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
+  // Blocks along each axis must be wider than reach_lo + reach_hi cells so that blocks two apart
+  // (same colour) touch disjoint nodes. Cells are split evenly, so every block has at least the
+  // minimum width even when the block count does not divide the cell count.
+  constexpr int preferred_width = 8;
+  IVec<D> n_blocks, n_colours;
+  for (int a = 0; a < D; ++a) {
+    const int min_width = std::max(preferred_width, cache.reach_lo[a] + cache.reach_hi[a] + 2);
+    n_blocks[a] = std::max(1, grid.n_cells()[a] / min_width);
+    if (n_blocks[a] == 1) {
+      n_colours[a] = 1;
+    } else if (grid.periodic(a) && n_blocks[a] % 2 == 1) {
+      n_colours[a] = 3;  // odd ring: the last block takes a third colour
+    } else {
+      n_colours[a] = 2;
+    }
+  }
+  const int total_blocks = n_blocks.prod();
+  const int total_colours = n_colours.prod();
+  const auto n = static_cast<std::int64_t>(cache.count.size());
+
+  auto block_along = [&](int a, int c) {
+    const int nc = grid.n_cells()[a];
+    if (grid.periodic(a)) {
+      c %= nc;
+      if (c < 0) c += nc;
+    }
+    const long long b = static_cast<long long>(c) * n_blocks[a] / nc;
+    return static_cast<int>(std::clamp<long long>(b, 0, n_blocks[a] - 1));
+  };
+
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < n; ++p) {
+    int id = 0, mult = 1;
+    for (int a = 0; a < D; ++a) {
+      id += block_along(a, cache.cell[p][a]) * mult;
+      mult *= n_blocks[a];
+    }
+    cache.block_of[p] = id;
+  }
+
+  // Stable counting sort of particles by block.
+  cache.block_begin.assign(total_blocks + 1, 0);
+  for (std::int64_t p = 0; p < n; ++p) ++cache.block_begin[cache.block_of[p] + 1];
+  for (int b = 0; b < total_blocks; ++b) cache.block_begin[b + 1] += cache.block_begin[b];
+  cache.cursor.assign(cache.block_begin.begin(), cache.block_begin.end() - 1);
+  for (std::int64_t p = 0; p < n; ++p)
+    cache.order[cache.cursor[cache.block_of[p]]++] = static_cast<std::int32_t>(p);
+
+  cache.colour_blocks.resize(total_colours);
+  for (auto& list : cache.colour_blocks) list.clear();
+  for (int b = 0; b < total_blocks; ++b) {
+    if (cache.block_begin[b + 1] == cache.block_begin[b]) continue;  // empty block
+    int rem = b, colour = 0, mult = 1;
+    for (int a = 0; a < D; ++a) {
+      const int k = rem % n_blocks[a];
+      rem /= n_blocks[a];
+      int c = k % 2;
+      if (n_colours[a] == 3 && k == n_blocks[a] - 1) c = 2;
+      if (n_colours[a] == 1) c = 0;
+      colour += c * mult;
+      mult *= n_colours[a];
+    }
+    cache.colour_blocks[colour].push_back(b);
+  }
+}
+
+template void colour_blocks<1>(const Grid<1>&, TransferCache<1>&);
+template void colour_blocks<2>(const Grid<2>&, TransferCache<2>&);
+template void colour_blocks<3>(const Grid<3>&, TransferCache<3>&);
+
+}  // namespace cairn

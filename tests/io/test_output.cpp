@@ -1,0 +1,529 @@
+// Tests of the output layer: atomic writes, history CSV, HDF5/XDMF snapshots, checkpoints.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <string>
+#include <vector>
+
+#include "cairn/io/atomic_file.hpp"
+#include "cairn/io/checkpoint.hpp"
+#include "cairn/io/hdf5_util.hpp"
+#include "cairn/io/history.hpp"
+#include "cairn/io/snapshot.hpp"
+
+namespace fs = std::filesystem;
+using namespace cairn;
+
+namespace {
+
+/// A fresh, empty directory for one test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+    for (char& c : name)
+      if (c == '/') c = '_';
+    path_ = fs::temp_directory_path() / ("cairn_io_" + std::to_string(::getpid()) + "_" + name);
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_all(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> list_dir(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+template <int D>
+Particles<D> random_particles(std::size_t n, int n_state, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0e3, 1.0e3);
+  std::uniform_int_distribution<int> k(-5, 40);
+  Particles<D> ps;
+  ps.n_state_per_particle = n_state;
+  ps.resize(n);
+  auto vec = [&] {
+    Vec<D> v;
+    for (int a = 0; a < D; ++a) v[a] = u(rng);
+    return v;
+  };
+  auto mat = [&] {
+    Mat3 m;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) m(i, j) = u(rng);
+    return m;
+  };
+  for (std::size_t p = 0; p < n; ++p) {
+    ps.position[p] = vec();
+    ps.reference_position[p] = vec();
+    ps.velocity[p] = vec();
+    ps.mass[p] = std::abs(u(rng)) * 1e-7;
+    ps.volume0[p] = std::abs(u(rng)) * 1e-12;
+    ps.size0[p] = vec();
+    ps.deformation_gradient[p] = mat();
+    ps.kirchhoff_stress[p] = mat() * 1e9;
+    ps.velocity_gradient[p] = mat();
+    ps.material[p] = k(rng);
+    ps.body[p] = k(rng);
+  }
+  for (double& s : ps.state) s = u(rng) / 7.0;
+  if (n > 0) {  // awkward values that must survive exactly
+    ps.position[0][0] = -0.0;
+    ps.mass[0] = std::numeric_limits<double>::denorm_min();
+    ps.kirchhoff_stress[0](1, 2) = std::numeric_limits<double>::max();
+    ps.velocity_gradient[0](2, 0) = std::numeric_limits<double>::infinity();
+  }
+  return ps;
+}
+
+template <int D>
+void expect_vecs_identical(const std::vector<Vec<D>>& a, const std::vector<Vec<D>>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t p = 0; p < a.size(); ++p)
+    for (int i = 0; i < D; ++i) EXPECT_TRUE(same_bits(a[p][i], b[p][i])) << what << " particle " << p;
+}
+
+void expect_mats_identical(const std::vector<Mat3>& a, const std::vector<Mat3>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    EXPECT_TRUE(a[p] == b[p]) << what << " particle " << p;
+    for (int i = 0; i < 9; ++i) EXPECT_TRUE(same_bits(a[p].data()[i], b[p].data()[i])) << what;
+  }
+}
+
+template <int D>
+void expect_particles_identical(const Particles<D>& a, const Particles<D>& b) {
+  EXPECT_EQ(a.n_state_per_particle, b.n_state_per_particle);
+  expect_vecs_identical<D>(a.position, b.position, "position");
+  expect_vecs_identical<D>(a.reference_position, b.reference_position, "reference_position");
+  expect_vecs_identical<D>(a.velocity, b.velocity, "velocity");
+  expect_vecs_identical<D>(a.size0, b.size0, "size0");
+  EXPECT_TRUE(same_bits(a.mass, b.mass));
+  EXPECT_TRUE(same_bits(a.volume0, b.volume0));
+  EXPECT_TRUE(a.mass == b.mass);
+  expect_mats_identical(a.deformation_gradient, b.deformation_gradient, "F");
+  expect_mats_identical(a.kirchhoff_stress, b.kirchhoff_stress, "tau");
+  expect_mats_identical(a.velocity_gradient, b.velocity_gradient, "grad v");
+  EXPECT_EQ(a.material, b.material);
+  EXPECT_EQ(a.body, b.body);
+  EXPECT_TRUE(a.state == b.state);
+  EXPECT_TRUE(same_bits(a.state, b.state));
+}
+
+template <typename Dim>
+class CheckpointTest : public ::testing::Test {};
+using Dims = ::testing::Types<std::integral_constant<int, 1>, std::integral_constant<int, 2>,
+                              std::integral_constant<int, 3>>;
+TYPED_TEST_SUITE(CheckpointTest, Dims);
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Atomic writes
+
+TEST(AtomicFile, WriteLeavesNoTempFile) {
+  TempDir dir;
+  const fs::path target = dir.path() / "sub" / "a.txt";
+  write_text_atomically(target, "hello\n");
+  EXPECT_EQ(read_all(target), "hello\n");
+  write_text_atomically(target, "second");
+  EXPECT_EQ(read_all(target), "second");
+  EXPECT_EQ(list_dir(target.parent_path()), std::vector<std::string>{"a.txt"});
+}
+
+TEST(AtomicFile, TempPathIsNextToTarget) {
+  const fs::path tmp = atomic_temp_path("/some/dir/file.h5");
+  EXPECT_EQ(tmp.parent_path(), fs::path("/some/dir"));
+  EXPECT_EQ(tmp.filename().string(), "file.h5.tmp." + std::to_string(::getpid()));
+}
+
+TEST(AtomicFile, ExceptionKeepsOldTarget) {
+  TempDir dir;
+  const fs::path target = dir.path() / "b.txt";
+  write_text_atomically(target, "old contents");
+  EXPECT_THROW(write_file_atomically(target,
+                                     [](const fs::path& tmp) {
+                                       std::ofstream(tmp) << "partial new con";
+                                       throw std::runtime_error("disk on fire");
+                                     }),
+               std::runtime_error);
+  EXPECT_EQ(read_all(target), "old contents");
+  EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"b.txt"});
+}
+
+TEST(AtomicFile, ExceptionWithoutTargetCreatesNothing) {
+  TempDir dir;
+  const fs::path target = dir.path() / "c.txt";
+  EXPECT_THROW(write_file_atomically(target, [](const fs::path&) { throw std::logic_error("x"); }),
+               std::logic_error);
+  EXPECT_TRUE(list_dir(dir.path()).empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// History
+
+TEST(History, FlushWritesHeaderAndRows) {
+  TempDir dir;
+  const fs::path path = dir.path() / "history.csv";
+  HistoryWriter h(path, {"kinetic_energy", "momentum_x"});
+  EXPECT_EQ(h.columns(), (std::vector<std::string>{"time", "step", "dt", "kinetic_energy", "momentum_x"}));
+  h.flush();
+  EXPECT_EQ(read_all(path), "time,step,dt,kinetic_energy,momentum_x\n");
+  h.add_row({0.0, 0.0, 0.0, 0.5, -2.0});
+  h.add_row(0.1, 3, 1e-5, {1.0 / 3.0, 1e300});
+  h.flush();
+  EXPECT_EQ(read_all(path),
+            "time,step,dt,kinetic_energy,momentum_x\n"
+            "0,0,0,0.5,-2\n"
+            "0.10000000000000001,3,1.0000000000000001e-05,0.33333333333333331,1.0000000000000001e+300\n");
+  EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"history.csv"});
+}
+
+TEST(History, RowsRoundTripThroughSetRows) {
+  TempDir dir;
+  HistoryWriter a(dir.path() / "a.csv", {"e"});
+  for (int i = 0; i < 5; ++i) a.add_row(0.1 * i, i, 0.1, {std::sqrt(i + 0.5)});
+  HistoryWriter b(dir.path() / "b.csv", a.columns());  // full column list is accepted as well
+  EXPECT_EQ(b.columns(), a.columns());
+  b.set_rows(a.rows());
+  EXPECT_EQ(b.csv_text(), a.csv_text());
+  a.add_row(0.5, 5, 0.1, {7.0});
+  b.add_row(0.5, 5, 0.1, {7.0});
+  a.flush();
+  b.flush();
+  EXPECT_EQ(read_all(dir.path() / "a.csv"), read_all(dir.path() / "b.csv"));
+}
+
+TEST(History, RejectsWrongRowLength) {
+  HistoryWriter h("unused.csv", {"e", "f"});
+  EXPECT_THROW(h.add_row({1.0, 2.0, 3.0}), std::invalid_argument);
+  EXPECT_THROW(h.set_rows({{1.0, 2.0, 3.0, 4.0}}), std::invalid_argument);
+  EXPECT_THROW(HistoryWriter("x.csv", {"bad,name"}), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checkpoints
+
+TYPED_TEST(CheckpointTest, RoundTripIsBitIdentical) {
+  constexpr int D = TypeParam::value;
+  TempDir dir;
+  std::mt19937_64 rng(1234 + D);
+  CheckpointData<D> data;
+  data.config_toml = "[simulation]\ndimension = 2\ntitle = \"quoted \\\"text\\\" with ünïcode\"\n";
+  data.time = 1.0 / 3.0;
+  data.step = 123456789012LL;
+  data.previous_dt = 2.0e-7 / 3.0;
+  data.scalars = {{"external_work", -4.0 / 7.0}, {"next_snapshot_time", 0.25}, {"a b", 1e-300}};
+  data.history_columns = {"time", "step", "dt", "kinetic_energy"};
+  for (int r = 0; r < 4; ++r) data.history_rows.push_back({r * 0.1, double(r), 0.1 / 3.0, std::exp(r * 1.1)});
+  data.snapshot_entries = {{0.0, "particles-000000.h5"}, {0.1 / 3.0, "particles-000001.h5"}};
+  data.snapshot_next_index = 2;
+  data.particles = random_particles<D>(37, 3, rng);
+
+  const fs::path path = dir.path() / "checkpoint.h5";
+  write_checkpoint<D>(path, data);
+  EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"checkpoint.h5"});
+  EXPECT_EQ(checkpoint_dimension(path), D);
+
+  const CheckpointData<D> back = read_checkpoint<D>(path);
+  EXPECT_EQ(back.config_toml, data.config_toml);
+  EXPECT_TRUE(same_bits(back.time, data.time));
+  EXPECT_EQ(back.step, data.step);
+  EXPECT_TRUE(same_bits(back.previous_dt, data.previous_dt));
+  EXPECT_EQ(back.scalars, data.scalars);
+  EXPECT_EQ(back.history_columns, data.history_columns);
+  EXPECT_EQ(back.history_rows, data.history_rows);
+  EXPECT_EQ(back.snapshot_entries, data.snapshot_entries);
+  EXPECT_EQ(back.snapshot_next_index, data.snapshot_next_index);
+  expect_particles_identical<D>(back.particles, data.particles);
+
+  // Writing what was read gives the same checkpoint again.
+  const fs::path again = dir.path() / "again.h5";
+  write_checkpoint<D>(again, back);
+  expect_particles_identical<D>(read_checkpoint<D>(again).particles, data.particles);
+}
+
+TYPED_TEST(CheckpointTest, EmptyStateRoundTrips) {
+  constexpr int D = TypeParam::value;
+  TempDir dir;
+  CheckpointData<D> data;  // no particles, no history, no snapshots, empty config
+  const fs::path path = dir.path() / "empty.h5";
+  write_checkpoint<D>(path, data);
+  const CheckpointData<D> back = read_checkpoint<D>(path);
+  EXPECT_EQ(back.config_toml, "");
+  EXPECT_EQ(back.particles.n(), 0u);
+  EXPECT_EQ(back.particles.n_state_per_particle, 0);
+  EXPECT_TRUE(back.history_rows.empty());
+  EXPECT_TRUE(back.history_columns.empty());
+  EXPECT_TRUE(back.snapshot_entries.empty());
+  EXPECT_TRUE(back.scalars.empty());
+}
+
+TEST(Checkpoint, WrongDimensionThrows) {
+  TempDir dir;
+  CheckpointData<3> data;
+  const fs::path path = dir.path() / "c3.h5";
+  write_checkpoint<3>(path, data);
+  try {
+    (void)read_checkpoint<2>(path);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("3D"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Checkpoint, NonCheckpointFilesThrowClearly) {
+  TempDir dir;
+  auto expect_message = [](const fs::path& p, const std::string& needle) {
+    try {
+      (void)read_checkpoint<2>(p);
+      ADD_FAILURE() << "expected an exception for " << p;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)checkpoint_dimension(p), std::runtime_error);
+  };
+
+  expect_message(dir.path() / "missing.h5", "does not exist");
+
+  const fs::path text = dir.path() / "input.toml";
+  write_text_atomically(text, "[simulation]\ndimension = 2\n");
+  expect_message(text, "not a Cairn checkpoint");
+
+  // A valid HDF5 file, but a snapshot rather than a checkpoint.
+  SnapshotWriter<2> snapshots(dir.path());
+  Particles<2> ps;
+  ps.add(Vec<2>(0.5, 0.5), Vec<2>(1.0, 0.0), 1.0, 1.0, Vec<2>(0.5, 0.5), 0, 0);
+  snapshots.write(ps, 0.0, 0);
+  expect_message(snapshots.snapshot_path(0), "not a Cairn checkpoint");
+
+  // An HDF5 file with no attributes at all.
+  const fs::path bare = dir.path() / "bare.h5";
+  { h5::Handle f = h5::create_file(bare); }
+  expect_message(bare, "not a Cairn checkpoint");
+
+  // A checkpoint of a future format version.
+  const fs::path future = dir.path() / "future.h5";
+  write_checkpoint<2>(future, CheckpointData<2>{});
+  {
+    h5::Handle f(H5Fopen(future.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+    ASSERT_GE(f.get(), 0);
+    h5::write_int64_attribute(f.get(), "version", 2);
+  }
+  expect_message(future, "version 2");
+}
+
+TEST(Checkpoint, InconsistentParticlesRejected) {
+  TempDir dir;
+  CheckpointData<2> data;
+  data.particles.add(Vec<2>(0, 0), Vec<2>(0, 0), 1, 1, Vec<2>(1, 1), 0, 0);
+  data.particles.mass.push_back(2.0);
+  EXPECT_THROW(write_checkpoint<2>(dir.path() / "bad.h5", data), std::invalid_argument);
+  EXPECT_TRUE(list_dir(dir.path()).empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Snapshots
+
+TEST(Snapshot, WritesParticlesAndXdmf) {
+  TempDir dir;
+  Particles<2> ps;
+  ps.add(Vec<2>(0.1, 0.2), Vec<2>(1.0, -2.0), 3.0, 0.5, Vec<2>(0.1, 0.1), 1, 4);
+  ps.add(Vec<2>(0.3, 0.4), Vec<2>(0.0, 0.0), 5.0, 0.25, Vec<2>(0.1, 0.1), 0, 2);
+  ps.position[0] = Vec<2>(0.15, 0.1);
+  ps.deformation_gradient[0] = Eigen::Vector3d(2.0, 1.0, 1.0).asDiagonal();
+  ps.kirchhoff_stress[0] = Eigen::Vector3d(4.0, 2.0, 2.0).asDiagonal();  // sigma = diag(2, 1, 1)
+  ps.kirchhoff_stress[0](0, 1) = ps.kirchhoff_stress[0](1, 0) = 6.0;    // sigma_xy = 3
+
+  SnapshotWriter<2> writer(dir.path());
+  EXPECT_EQ(writer.next_index(), 0);
+  writer.write(ps, 0.0, 0);
+  writer.write(ps, 0.5, 10);
+  EXPECT_EQ(writer.next_index(), 2);
+  ASSERT_EQ(writer.entries().size(), 2u);
+  EXPECT_EQ(writer.entries()[1], (std::pair<double, std::string>(0.5, "particles-000001.h5")));
+  EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"particles.xdmf", "snapshots"}));
+  EXPECT_EQ(list_dir(dir.path() / "snapshots"),
+            (std::vector<std::string>{"particles-000000.h5", "particles-000001.h5"}));
+
+  const std::string xdmf = read_all(writer.particles_xdmf_path());
+  EXPECT_NE(xdmf.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_NE(xdmf.find("snapshots/particles-000000.h5:/particles/position"), std::string::npos);
+  EXPECT_NE(xdmf.find("snapshots/particles-000001.h5:/particles/stress"), std::string::npos);
+  EXPECT_NE(xdmf.find("TopologyType=\"Polyvertex\" NumberOfElements=\"2\""), std::string::npos);
+  EXPECT_NE(xdmf.find("<Time Value=\"0.5\"/>"), std::string::npos);
+
+  h5::Handle f = h5::open_file(writer.snapshot_path(1));
+  EXPECT_EQ(h5::read_double_attribute(f.get(), "time"), 0.5);
+  EXPECT_EQ(h5::read_int64_attribute(f.get(), "step"), 10);
+  EXPECT_EQ(h5::read_int64_attribute(f.get(), "dimension"), 2);
+  h5::Handle g = h5::open_group(f.get(), "particles");
+  const auto pos = h5::read_doubles(g.get(), "position", {2, 3});
+  EXPECT_EQ(pos, (std::vector<double>{0.15, 0.1, 0.0, 0.3, 0.4, 0.0}));
+  const auto disp = h5::read_doubles(g.get(), "displacement", {2, 3});
+  EXPECT_DOUBLE_EQ(disp[0], 0.05);
+  EXPECT_DOUBLE_EQ(disp[1], -0.1);
+  EXPECT_EQ(h5::read_doubles(g.get(), "mass", {2}), (std::vector<double>{3.0, 5.0}));
+  EXPECT_EQ(h5::read_doubles(g.get(), "volume", {2}), (std::vector<double>{1.0, 0.25}));
+  const auto stress = h5::read_doubles(g.get(), "stress", {2, 6});
+  EXPECT_EQ(std::vector<double>(stress.begin(), stress.begin() + 6),
+            (std::vector<double>{2.0, 1.0, 1.0, 0.0, 0.0, 3.0}));
+  EXPECT_DOUBLE_EQ(h5::read_doubles(g.get(), "pressure", {2})[0], -4.0 / 3.0);
+  EXPECT_DOUBLE_EQ(h5::read_doubles(g.get(), "von_mises", {2})[0], std::sqrt(1.0 + 27.0));
+  const auto F = h5::read_doubles(g.get(), "deformation_gradient", {2, 9});
+  EXPECT_EQ(std::vector<double>(F.begin(), F.begin() + 9),
+            (std::vector<double>{2, 0, 0, 0, 1, 0, 0, 0, 1}));
+  EXPECT_EQ(h5::read_ints(g.get(), "material", 2), (std::vector<std::int32_t>{1, 0}));
+  EXPECT_EQ(h5::read_ints(g.get(), "body", 2), (std::vector<std::int32_t>{4, 2}));
+}
+
+TEST(Snapshot, GridDataAndGridXdmf) {
+  TempDir dir;
+  // 4 x 2 cells, h = (0.5, 0.25), one ghost layer, y periodic.
+  Grid<2> grid(Vec<2>(1.0, 2.0), IVec<2>(4, 2), Vec<2>(0.5, 0.25), 1, {false, true});
+  ASSERT_EQ(grid.stored_nodes(0), 7);
+  ASSERT_EQ(grid.stored_nodes(1), 2);
+  NodeField<2> nodes;
+  nodes.resize(grid.n_nodes());
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    nodes.mass[i] = i;
+    nodes.velocity_new[i] = Vec<2>(i, -i);
+  }
+  Particles<2> ps;
+  ps.add(Vec<2>(1.5, 2.1), Vec<2>(0, 0), 1.0, 1.0, Vec<2>(0.25, 0.125), 0, 0);
+  SnapshotWriter<2> writer(dir.path());
+  writer.write(ps, 0.0, 0, &grid, &nodes);
+  ASSERT_TRUE(fs::exists(writer.grid_xdmf_path()));
+  EXPECT_EQ(writer.grid_xdmf_path(), dir.path() / "grid.xdmf");
+  const std::string xdmf = read_all(writer.grid_xdmf_path());
+  EXPECT_NE(xdmf.find("TopologyType=\"2DCoRectMesh\" Dimensions=\"2 7\""), std::string::npos) << xdmf;
+  EXPECT_NE(xdmf.find(">2 0.5</DataItem>"), std::string::npos) << xdmf;     // origin y x
+  EXPECT_NE(xdmf.find(">0.25 0.5</DataItem>"), std::string::npos) << xdmf;  // spacing y x
+  EXPECT_NE(xdmf.find("snapshots/particles-000000.h5:/grid/node_velocity"), std::string::npos);
+
+  h5::Handle f = h5::open_file(writer.snapshot_path(0));
+  h5::Handle g = h5::open_group(f.get(), "grid");
+  EXPECT_EQ(h5::dataset_shape(g.get(), "node_mass"), (std::vector<std::size_t>{2, 7}));
+  const auto mass = h5::read_doubles(g.get(), "node_mass", {2, 7});
+  EXPECT_EQ(mass, nodes.mass);
+  const auto vel = h5::read_doubles(g.get(), "node_velocity", {2, 7, 3});
+  EXPECT_EQ(vel[3 * 9 + 0], 9.0);
+  EXPECT_EQ(vel[3 * 9 + 1], -9.0);
+  EXPECT_EQ(vel[3 * 9 + 2], 0.0);
+  EXPECT_EQ(h5::read_doubles_attribute(g.get(), "origin"), (std::vector<double>{0.5, 2.0, 0.0}));
+  // Stored node 0 really is at the origin written.
+  EXPECT_EQ(grid.node_position(0), Vec<2>(0.5, 2.0));
+}
+
+TEST(Snapshot, OtherDimensionsWrite) {
+  TempDir dir;
+  {
+    Grid<1> grid(Vec<1>(0.0), IVec<1>(3), Vec<1>(1.0), 2, {false});
+    NodeField<1> nodes;
+    nodes.resize(grid.n_nodes());
+    Particles<1> ps;
+    ps.add(Vec<1>(0.5), Vec<1>(1.0), 1.0, 1.0, Vec<1>(0.5), 0, 0);
+    SnapshotWriter<1> writer(dir.path() / "d1");
+    writer.write(ps, 0.0, 0, &grid, &nodes);
+    EXPECT_NE(read_all(writer.grid_xdmf_path()).find("Dimensions=\"1 8\""), std::string::npos);
+    h5::Handle f = h5::open_file(writer.snapshot_path(0));
+    h5::Handle g = h5::open_group(f.get(), "particles");
+    EXPECT_EQ(h5::read_doubles(g.get(), "velocity", {1, 3}), (std::vector<double>{1.0, 0.0, 0.0}));
+  }
+  {
+    Grid<3> grid(Vec<3>(0, 0, 0), IVec<3>(2, 3, 4), Vec<3>(1, 2, 3), 1, {false, false, false});
+    NodeField<3> nodes;
+    nodes.resize(grid.n_nodes());
+    Particles<3> ps;
+    ps.add(Vec<3>(0.5, 0.5, 0.5), Vec<3>(1, 2, 3), 1.0, 1.0, Vec<3>(0.5, 0.5, 0.5), 0, 0);
+    SnapshotWriter<3> writer(dir.path() / "d3", "solid");
+    writer.write(ps, 0.0, 0, &grid, &nodes);
+    EXPECT_TRUE(fs::exists(dir.path() / "d3" / "solid.xdmf"));
+    EXPECT_TRUE(fs::exists(dir.path() / "d3" / "snapshots" / "solid-000000.h5"));
+    const std::string xdmf = read_all(writer.grid_xdmf_path());
+    EXPECT_NE(xdmf.find("TopologyType=\"3DCoRectMesh\" Dimensions=\"7 6 5\""), std::string::npos) << xdmf;
+    EXPECT_NE(xdmf.find(">-3 -2 -1</DataItem>"), std::string::npos) << xdmf;
+  }
+}
+
+TEST(Snapshot, RestartContinuesListing) {
+  TempDir dir;
+  Particles<2> ps;
+  ps.add(Vec<2>(0.5, 0.5), Vec<2>(0, 0), 1.0, 1.0, Vec<2>(0.5, 0.5), 0, 0);
+  std::vector<std::pair<double, std::string>> saved;
+  int saved_index = 0;
+  {
+    SnapshotWriter<2> first(dir.path());
+    first.write(ps, 0.0, 0);
+    first.write(ps, 0.1, 1);
+    saved = first.entries();  // "checkpoint" here
+    saved_index = first.next_index();
+    first.write(ps, 0.2, 2);  // written after the checkpoint, then the run dies
+  }
+  SnapshotWriter<2> second(dir.path());
+  second.set_entries(saved);
+  second.set_next_index(saved_index);
+  ps.add(Vec<2>(0.6, 0.6), Vec<2>(0, 0), 1.0, 1.0, Vec<2>(0.5, 0.5), 0, 0);
+  second.write(ps, 0.2, 2);
+  ASSERT_EQ(second.entries().size(), 3u);
+  EXPECT_EQ(second.entries()[2].second, "particles-000002.h5");
+  const std::string xdmf = read_all(second.particles_xdmf_path());
+  for (const char* f : {"particles-000000.h5", "particles-000001.h5", "particles-000002.h5"}) {
+    EXPECT_NE(xdmf.find(std::string("snapshots/") + f + ":/particles/mass"), std::string::npos) << f;
+  }
+  // Old files keep their particle counts, the rewritten one has the new count.
+  EXPECT_NE(xdmf.find("NumberOfElements=\"1\""), std::string::npos);
+  EXPECT_NE(xdmf.find("NumberOfElements=\"2\""), std::string::npos);
+  EXPECT_EQ(xdmf.find("particles-000003"), std::string::npos);
+  EXPECT_EQ(list_dir(dir.path() / "snapshots").size(), 3u);  // no temp files left
+}
+
+TEST(Snapshot, MissingListedFileIsLeftOut) {
+  TempDir dir;
+  Particles<2> ps;
+  ps.add(Vec<2>(0.5, 0.5), Vec<2>(0, 0), 1.0, 1.0, Vec<2>(0.5, 0.5), 0, 0);
+  SnapshotWriter<2> writer(dir.path());
+  writer.set_entries({{0.0, "particles-000000.h5"}});  // never written
+  writer.set_next_index(1);
+  writer.write(ps, 0.1, 1);
+  const std::string xdmf = read_all(writer.particles_xdmf_path());
+  EXPECT_EQ(xdmf.find("particles-000000.h5"), std::string::npos);
+  EXPECT_NE(xdmf.find("particles-000001.h5"), std::string::npos);
+  EXPECT_EQ(writer.entries().size(), 2u);
+}

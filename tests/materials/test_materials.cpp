@@ -1,0 +1,121 @@
+// Each material against hand-computed stresses and energies, and the energy/stress consistency
+// tau = dW/dF F^T checked by finite differences.
+#include <gtest/gtest.h>
+
+#include "cairn/materials/material.hpp"
+
+namespace cairn {
+namespace {
+
+MaterialConfig config(const std::string& model, std::map<std::string, double> numbers,
+                      std::string form = "") {
+  MaterialConfig m;
+  m.name = "m";
+  m.model = model;
+  m.numbers = std::move(numbers);
+  m.numbers["density"] = 1000.0;
+  if (!form.empty()) m.strings["form"] = form;
+  return m;
+}
+
+Mat3 sample_F() {
+  Mat3 F;
+  F << 1.05, 0.02, 0.0, -0.01, 0.97, 0.03, 0.004, 0.0, 1.01;
+  return F;
+}
+
+/// tau = (dW/dF) F^T from central differences of the energy.
+Mat3 kirchhoff_from_energy(const Material& m, const Mat3& F) {
+  Mat3 P;
+  const double h = 1e-6;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Mat3 Fp = F, Fm = F;
+      Fp(i, j) += h;
+      Fm(i, j) -= h;
+      P(i, j) = (m.energy_density(Fp) - m.energy_density(Fm)) / (2 * h);
+    }
+  return P * F.transpose();
+}
+
+TEST(Materials, LinearElasticUniaxialStrainByHand) {
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  Mat3 F = Mat3::Identity();
+  F(0, 0) = 1.001;
+  const Mat3 sigma = m->kirchhoff(F) / F.determinant();
+  EXPECT_NEAR(sigma(0, 0), (2.0 + 2 * 3.0) * 0.001, 1e-15);
+  EXPECT_NEAR(sigma(1, 1), 2.0 * 0.001, 1e-15);
+  EXPECT_NEAR(m->energy_density(F), 0.5 * 8.0 * 1e-6, 1e-18);
+  EXPECT_NEAR(m->wave_speed(F), std::sqrt(8.0 / 1000.0), 1e-15);
+}
+
+TEST(Materials, ElasticConstantPairsAgree) {
+  // E = 10 MPa, nu = 0.25  <=>  lambda = G = 4 MPa  <=>  K = 6.6667 MPa, G = 4 MPa
+  auto a = make_material(config("linear_elastic", {{"youngs_modulus", 10e6}, {"poissons_ratio", 0.25}}));
+  auto b = make_material(config("linear_elastic", {{"lambda", 4e6}, {"shear_modulus", 4e6}}));
+  auto c = make_material(config("linear_elastic", {{"bulk_modulus", 4e6 + 8e6 / 3}, {"shear_modulus", 4e6}}));
+  const Mat3 F = sample_F();
+  EXPECT_LT((a->kirchhoff(F) - b->kirchhoff(F)).norm(), 1e-6);
+  EXPECT_LT((a->kirchhoff(F) - c->kirchhoff(F)).norm(), 1e-6);
+}
+
+TEST(Materials, NeoHookeanLnJByHand) {
+  // seed 001 Eq. 32 for uniaxial stretch F = diag(s, 1, 1): sigma_xx = (lambda ln s + G (s^2-1))/s
+  auto m = make_material(config("neo_hookean", {{"lambda", 2.0}, {"shear_modulus", 3.0}}, "ln_j"));
+  Mat3 F = Mat3::Identity();
+  const double s = 1.2;
+  F(0, 0) = s;
+  const Mat3 sigma = m->kirchhoff(F) / s;
+  EXPECT_NEAR(sigma(0, 0), (2.0 * std::log(s) + 3.0 * (s * s - 1.0)) / s, 1e-14);
+  EXPECT_NEAR(sigma(1, 1), 2.0 * std::log(s) / s, 1e-14);
+  EXPECT_NEAR(m->energy_density(F), 0.5 * 2.0 * std::log(s) * std::log(s) - 3.0 * std::log(s) +
+                                        0.5 * 3.0 * (s * s - 1.0), 1e-14);
+}
+
+TEST(Materials, NeoHookean1DZeroPoissonIsSeed003Eq50) {
+  // lambda = 0, G = E/2: sigma = E/2 (F - 1/F)
+  auto m = make_material(config("neo_hookean", {{"youngs_modulus", 1e4}, {"poissons_ratio", 0.0}}, "ln_j"));
+  Mat3 F = Mat3::Identity();
+  F(0, 0) = 0.9;
+  EXPECT_NEAR(m->kirchhoff(F)(0, 0) / 0.9, 0.5e4 * (0.9 - 1 / 0.9), 1e-10);
+}
+
+TEST(Materials, NeoHookeanJSquaredByHand) {
+  // seed 000 Eq. 6: sigma = lambda/2 (J - 1/J) I + G/J (B - I)
+  auto m = make_material(config("neo_hookean", {{"lambda", 7.29766e6}, {"shear_modulus", 3.7594e6}}, "j_squared"));
+  const Mat3 F = sample_F();
+  const double J = F.determinant();
+  const Mat3 expected = 0.5 * 7.29766e6 * (J - 1 / J) * Mat3::Identity() +
+                        3.7594e6 / J * (F * F.transpose() - Mat3::Identity());
+  EXPECT_LT((m->kirchhoff(F) / J - expected).norm(), 1e-6);
+}
+
+TEST(Materials, NeoHookeanIsochoricIsDeviatoricInShear) {
+  // seed 004 Eq. 18: a volume-preserving simple shear gives zero pressure.
+  auto m = make_material(config("neo_hookean", {{"bulk_modulus", 2450.0}, {"shear_modulus", 940.0}}, "isochoric"));
+  Mat3 F = Mat3::Identity();
+  F(0, 1) = 0.1;
+  const Mat3 tau = m->kirchhoff(F);
+  EXPECT_NEAR(tau.trace(), 0.0, 1e-10);
+  EXPECT_NEAR(tau(0, 1), 940.0 * 0.1, 1e-10);
+}
+
+TEST(Materials, EveryModelStressIsTheDerivativeOfItsEnergy) {
+  const Mat3 F = sample_F();
+  for (std::string form : {"ln_j", "j_squared", "isochoric"}) {
+    auto m = make_material(config("neo_hookean", {{"lambda", 2.0}, {"shear_modulus", 3.0}}, form));
+    EXPECT_LT((m->kirchhoff(F) - kirchhoff_from_energy(*m, F)).norm(), 1e-7) << form;
+    EXPECT_NEAR(m->energy_density(Mat3::Identity()), 0.0, 1e-15) << form;
+    EXPECT_LT(m->kirchhoff(Mat3::Identity()).norm(), 1e-15) << form;
+  }
+  auto le = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  Mat3 S = Mat3::Identity();  // symmetric small strain: small-strain law is its energy's derivative
+  S(0, 0) = 1.001;
+  S(1, 1) = 0.999;
+  // dW/dF of the small-strain law is the Cauchy stress itself.
+  const Mat3 P = kirchhoff_from_energy(*le, S) * S.transpose().inverse();
+  EXPECT_LT((le->kirchhoff(S) / S.determinant() - P).norm(), 1e-8);
+}
+
+}  // namespace
+}  // namespace cairn
