@@ -1,1 +1,125 @@
-int main() { return 0; }
+// The `cairn` command: run, check, keys, restart.
+//
+// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found); 3 the simulation
+// failed (which particle, step, time and quantity), after writing its last good output;
+// 1 anything else (an I/O failure, an internal error).
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <iostream>
+
+#include "cairn/io/errors.hpp"
+#include "cairn/io/input.hpp"
+#include "cairn/io/schema.hpp"
+#include "cairn/sim/run.hpp"
+#include "cairn/sim/simulation.hpp"
+#include "cairn/util/registry.hpp"
+
+namespace {
+
+template <int D>
+void describe_setup(const cairn::Config& config) {
+  cairn::Simulation<D> sim(config);
+  const auto& g = sim.grid();
+  std::string cells;
+  for (int a = 0; a < D; ++a) cells += (a ? " x " : "") + std::to_string(g.n_cells()[a]);
+  fmt::print("# grid: {} cells, {} stored nodes (ghost layers {})\n", cells, g.n_nodes(), g.ghost_layers());
+  std::vector<std::size_t> per_body(config.bodies.size(), 0);
+  for (auto b : sim.particles().body) ++per_body[b];
+  for (std::size_t b = 0; b < per_body.size(); ++b)
+    fmt::print("# body '{}': {} particles\n", config.bodies[b].name, per_body[b]);
+  fmt::print("# first time step: {:.6g}\n", sim.next_dt());
+}
+
+void describe(const cairn::Config& config) {
+  switch (config.simulation.dimension) {
+    case 1: describe_setup<1>(config); break;
+    case 2: describe_setup<2>(config); break;
+    default: describe_setup<3>(config); break;
+  }
+}
+
+void print_summary(const cairn::RunSummary& s) {
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} particle-steps/s with {} threads, "
+             "{} particles)\n",
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, omp_get_max_threads(),
+             s.n_particles);
+  fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
+  if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
+  app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
+  app.require_subcommand(1);
+
+  std::string input;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  int threads = 0;
+  bool markdown = false;
+
+  auto* run = app.add_subcommand("run", "run a simulation from a TOML input file");
+  run->add_option("input", input, "input file")->required();
+  run->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
+  run->add_flag("-q,--quiet", quiet, "no progress line and no summary");
+  run->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+
+  auto* check = app.add_subcommand("check", "validate an input file and print the resolved settings");
+  check->add_option("input", input, "input file")->required();
+  check->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
+
+  auto* keys = app.add_subcommand("keys", "print every input key with its type, default and doc");
+  keys->add_flag("--markdown", markdown, "print docs/input.md");
+
+  auto* restart = app.add_subcommand("restart", "continue a run from a checkpoint file");
+  restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
+  restart->add_option("--set", overrides, "override an input key of the stored input");
+  restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
+  restart->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+
+  CLI11_PARSE(app, argc, argv);
+  if (threads > 0) omp_set_num_threads(threads);
+
+  try {
+    if (*keys) {
+      std::cout << cairn::keys_text(markdown);
+      return 0;
+    }
+    if (*check) {
+      const cairn::Config config = cairn::load_config(input, overrides);
+      std::cout << config.resolved_toml;
+      describe(config);
+      return 0;
+    }
+    cairn::RunOptions options;
+    options.quiet = quiet;
+    cairn::RunSummary summary;
+    if (*run) {
+      const cairn::Config config = cairn::load_config(input, overrides);
+      summary = cairn::run(config, options);
+    } else {
+      summary = cairn::restart(input, overrides, options);
+    }
+    if (!quiet) print_summary(summary);
+    return 0;
+  } catch (const cairn::InputError& e) {
+    std::cerr << "cairn: input error: " << e.what() << "\n";
+    return 2;
+  } catch (const cairn::UnknownName& e) {
+    std::cerr << "cairn: input error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "cairn: input error: " << e.what() << "\n";
+    return 2;
+  } catch (const cairn::RunFailure& e) {
+    std::cerr << "cairn: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "cairn: error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -33,3 +33,18 @@ TEST(TensorExp, DeterminantIsExpOfTrace) {
 
 }  // namespace
 }  // namespace cairn
+
+#include <unsupported/Eigen/MatrixFunctions>
+
+namespace cairn {
+namespace {
+
+TEST(TensorExp, AgreesWithEigensPadeForLargeArguments) {
+  Mat3 a;
+  a << 1.2, -0.7, 0.3, 2.0, -0.4, 0.9, -1.1, 0.5, 0.8;
+  const Mat3 reference = a.exp();
+  EXPECT_LT((tensor_exp(a) - reference).norm(), 1e-13 * reference.norm());
+}
+
+}  // namespace
+}  // namespace cairn

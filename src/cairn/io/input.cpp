@@ -30,7 +30,8 @@ namespace {
 /// A key's position in the input tree: {"material", "0", "density"}.
 using Path = std::vector<std::string>;
 
-constexpr double ratio_tolerance = 1e-9;  ///< extent / cell_size must be this close to a whole number
+/// extent / cell_size must be this close (relative) to a whole number; quoted in the message.
+constexpr double ratio_tolerance = 1e-9;
 
 Path child(Path p, std::string part) {
   p.push_back(std::move(part));
@@ -475,12 +476,13 @@ const toml::array& TableReader::array_of(const Value& v, const std::string& name
 }
 
 std::vector<double> TableReader::reals(const std::string& name, std::size_t n, bool allow_scalar) {
-  Value v = required_value(name);
+  Value v = value(name);
   const std::string range = range_phrase(*v.decl);
   const std::string each = range.empty() ? "" : ", each" + range;
   std::string expected = fmt::format("an array of {} numbers{}{}", n, each,
                                      per_axis(n, loader_.dimension()));
   if (allow_scalar) expected = fmt::format("a number{} or {}", range, expected);
+  if (!v.node) fail(name, nullptr, expected + " (required key)", "nothing");
   if (allow_scalar && !v.node->is_array()) {
     const double x = number(v, path_of(name), expected);
     check_range(v, x, path_of(name), fmt::format("a number{}", range));
@@ -499,12 +501,13 @@ std::vector<double> TableReader::reals(const std::string& name, std::size_t n, b
 }
 
 std::vector<int> TableReader::integers(const std::string& name, std::size_t n, bool allow_scalar) {
-  Value v = required_value(name);
+  Value v = value(name);
   const std::string range = range_phrase(*v.decl);
   const std::string each = range.empty() ? "" : ", each" + range;
   std::string expected = fmt::format("an array of {} integers{}{}", n, each,
                                      per_axis(n, loader_.dimension()));
   if (allow_scalar) expected = fmt::format("an integer{} or {}", range, expected);
+  if (!v.node) fail(name, nullptr, expected + " (required key)", "nothing");
   auto one = [&](const Value& e, const Path& p, const std::string& what) {
     auto i = e.node->as_integer();
     if (!i) loader_.fail(p, e.node, what, found(e, true));
@@ -547,9 +550,10 @@ std::vector<std::string> TableReader::expressions(const std::string& name, std::
 
 std::vector<std::vector<double>> TableReader::points(const std::string& name, std::size_t n,
                                                      std::size_t min_count) {
-  Value v = required_value(name);
+  Value v = value(name);
   const std::string expected =
       fmt::format("an array of at least {} points, each an array of {} numbers", min_count, n);
+  if (!v.node) fail(name, nullptr, expected + " (required key)", "nothing");
   const toml::array& a = array_of(v, name, 0, expected);
   if (a.size() < min_count)
     fail(name, v.node, expected, fmt::format("{} ({} points)", node_text(*v.node), a.size()));
@@ -789,8 +793,8 @@ void Loader::read_grid(const toml::table& root, Config& cfg) {
     if (whole < 1.0 || std::abs(cells - whole) > ratio_tolerance * cells)
       r.fail("cell_size", r.given("cell_size"),
              fmt::format("grid.extent / grid.cell_size to be a whole number of cells on axis {} "
-                         "(within {} relative)",
-                         "xyz"[a], ratio_tolerance),
+                         "(within 1e-9 relative)",
+                         "xyz"[a]),
              fmt::format("{} / {} = {:.12g}", real_text(g.extent[a]), real_text(g.cell_size[a]), cells));
   }
 }

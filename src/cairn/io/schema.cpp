@@ -397,8 +397,8 @@ const std::vector<SectionDoc>& section_docs() {
 std::string md_cell(std::string s) {
   std::string out;
   for (char c : s) {
-    if (c == '|') out += "\\|";
-    else out += c;
+    if (c == '|' || c == '<') out += '\\';  // table separator; '<' would start an HTML tag
+    out += c;
   }
   return out;
 }
@@ -421,12 +421,21 @@ std::string md_default(const KeyDecl& d) {
   return md_code(d.default_value);
 }
 
-void md_table(std::string& out, const std::vector<KeyDecl>& keys) {
+void md_header(std::string& out) {
   out += "| key | type | default | range / choices | doc |\n";
   out += "|---|---|---|---|---|\n";
+}
+
+/// Rows of a key table; `prefix` is prepended to the key names ("circle." for shape parameters).
+void md_rows(std::string& out, const std::vector<KeyDecl>& keys, const std::string& prefix = "") {
   for (const auto& d : keys)
-    out += fmt::format("| `{}` | {} | {} | {} | {} |\n", d.name, md_cell(type_text(d)),
+    out += fmt::format("| `{}{}` | {} | {} | {} | {} |\n", prefix, d.name, md_cell(type_text(d)),
                        md_default(d), md_range(d), md_cell(d.doc));
+}
+
+void md_table(std::string& out, const std::vector<KeyDecl>& keys) {
+  md_header(out);
+  md_rows(out, keys);
 }
 
 std::vector<KeyDecl> copy_section(std::string_view section) {
@@ -461,17 +470,15 @@ std::string markdown_text() {
       "- `cairn check case.toml` validates an input and prints it with every default filled "
       "in.\n"
       "\n"
-      "Sections:";
-  for (const auto& s : section_docs()) out += fmt::format(" [{}](#{}) ·", s.heading, s.name);
-  out.pop_back();
-  out.pop_back();
-  out += "\n";
+      "Sections: ";
+  std::vector<std::string> links;
+  for (const auto& s : section_docs()) links.push_back(fmt::format("[`{}`](#{})", s.heading, s.name));
+  out += join(links, " · ") + "\n";
 
   for (const auto& s : section_docs()) {
     out += fmt::format("\n## {}\n\n{}\n\n", s.heading, s.intro);
     if (s.name == "constants") {
-      out += "| key | type | default | range / choices | doc |\n";
-      out += "|---|---|---|---|---|\n";
+      md_header(out);
       out += "| *any identifier* | real | none |  | A named number for expressions. |\n";
     } else {
       md_table(out, copy_section(s.name));
@@ -505,13 +512,9 @@ std::string markdown_text() {
         out += fmt::format("| `{}` | {} | {} |\n", kind.name, join(dims, ", "), md_cell(kind.doc));
       }
       out += "\n";
-      std::vector<KeyDecl> params;
+      md_header(out);
       for (const auto& kind : body_shape_kinds())
-        for (auto d : copy_section("body.shape." + kind.name)) {
-          d.name = kind.name + "." + d.name;
-          params.push_back(d);
-        }
-      md_table(out, params);
+        md_rows(out, copy_section("body.shape." + kind.name), kind.name + ".");
     }
   }
   return out;
@@ -543,9 +546,10 @@ std::vector<std::vector<std::string>> plain_table(const std::vector<KeyDecl>& ke
 
 std::string plain_text() {
   std::string out =
-      "Cairn input keys (D = simulation.dimension). Override any key with "
-      "--set section.key=value;\n"
-      "[[material]] and [[body]] entries by index: --set material.0.density=1100.\n";
+      "Cairn input keys; D = simulation.dimension. `cairn keys --markdown` gives the full "
+      "reference.\n"
+      "Override any key with --set section.key=value; [[material]] and [[body]] entries by "
+      "index: --set material.0.density=1100\n";
   for (const auto& s : section_docs()) {
     out += fmt::format("\n{}\n", s.heading);
     if (s.name == "constants") {

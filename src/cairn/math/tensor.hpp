@@ -8,9 +8,9 @@
 
 namespace cairn {
 
-/// exp(A) for a 3x3 matrix by Eigen's scaling-and-squaring Pade approximant
-/// (unsupported/MatrixFunctions). Accurate to round-off for the |A| << 1 increments of a stable
-/// MPM step and still correct for large arguments.
+/// exp(A) for a 3x3 matrix by scaling and squaring of a Taylor series run to round-off
+/// (see tensor.cpp). Exact to round-off for the |A| << 1 increments of a stable MPM step and
+/// still correct for large arguments; tested against Eigen's Pade-based MatrixFunctions.
 Mat3 tensor_exp(const Mat3& a);
 
 /// Truncated Taylor series sum_{k<=n} A^k / k!, the reference the exponential is tested against.

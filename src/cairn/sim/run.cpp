@@ -1,0 +1,274 @@
+#include "cairn/sim/run.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cairn/io/checkpoint.hpp"
+#include "cairn/io/history.hpp"
+#include "cairn/io/input.hpp"
+#include "cairn/io/snapshot.hpp"
+#include "cairn/sim/simulation.hpp"
+#include "cairn/util/failure.hpp"
+
+namespace cairn {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const std::vector<std::string> history_columns = {
+    "kinetic_energy", "strain_energy", "external_work", "total_energy", "energy_error",
+    "momentum_x",     "momentum_y",    "momentum_z"};
+
+/// Output schedule as integer counters so that output times do not drift with round-off.
+struct Schedule {
+  double interval = 0.0;
+  long long done = 0;  ///< outputs written at t > 0
+  [[nodiscard]] bool due(double t) const {
+    return interval > 0.0 && t >= static_cast<double>(done + 1) * interval * (1.0 - 1e-12);
+  }
+  void advance(double t) {
+    while (due(t)) ++done;
+  }
+};
+
+template <int D>
+class Runner {
+ public:
+  Runner(const Config& config, const RunOptions& options)
+      : config_(config),
+        options_(options),
+        sim_(config),
+        dir_(config.output.directory),
+        snapshots_(dir_) {
+    const auto& out = config_.output;
+    const double end = config_.simulation.end_time;
+    snapshot_.interval = out.every;
+    history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
+    checkpoint_.interval = out.checkpoint_every;
+    std::filesystem::create_directories(dir_);
+  }
+
+  void restore(const CheckpointData<D>& data) {
+    sim_.particles() = data.particles;
+    sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"));
+    initial_energy_ = data.scalars.at("initial_energy");
+    snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
+    history_.done = static_cast<long long>(data.scalars.at("history_done"));
+    checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
+    checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
+    last_dt_ = data.previous_dt;
+    history_writer_.set_rows(data.history_rows);
+    snapshots_.set_entries(data.snapshot_entries);
+    snapshots_.set_next_index(data.snapshot_next_index);
+    restarted_ = true;
+  }
+
+  RunSummary run() {
+    const auto start = Clock::now();
+    const long long first_step = sim_.step_count();
+    const auto& s = config_.simulation;
+    if (!restarted_) {
+      initial_energy_ = energy();
+      write_history_row();
+      write_snapshot();
+    }
+    bool wrote_history = true, wrote_snapshot = true;
+    while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
+      const double dt = sim_.next_dt();
+      try {
+        sim_.step(dt);
+      } catch (const SimulationFailure& f) {
+        fail(f);
+      }
+      last_dt_ = dt;
+      const double t = sim_.time();
+      wrote_history = wrote_snapshot = false;
+      if (history_.due(t)) {
+        history_.advance(t);
+        write_history_row();
+        wrote_history = true;
+      }
+      if (snapshot_.due(t)) {
+        snapshot_.advance(t);
+        write_snapshot();
+        wrote_snapshot = true;
+      }
+      if (checkpoint_.due(t)) {
+        checkpoint_.advance(t);
+        write_checkpoint_file();
+      }
+      progress(start, first_step);
+    }
+    if (!wrote_history) write_history_row();
+    if (!wrote_snapshot) write_snapshot();
+    history_writer_.flush();
+    if (config_.output.checkpoints) write_checkpoint_file();
+    finish_progress();
+
+    RunSummary summary;
+    summary.steps = sim_.step_count() - first_step;
+    summary.end_time = sim_.time();
+    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    summary.n_particles = sim_.particles().n();
+    summary.particle_steps_per_second =
+        summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
+    summary.output_directory = dir_;
+    summary.last_checkpoint = last_checkpoint_;
+    return summary;
+  }
+
+ private:
+  double energy() const {
+    const Totals t = sim_.totals();
+    return t.kinetic_energy + t.strain_energy;
+  }
+
+  void write_history_row() {
+    const Totals t = sim_.totals();
+    const double total = t.kinetic_energy + t.strain_energy;
+    history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_,
+                            {t.kinetic_energy, t.strain_energy, sim_.external_work(), total,
+                             total - initial_energy_ - sim_.external_work(), t.momentum[0],
+                             t.momentum[1], t.momentum[2]});
+    ++rows_since_flush_;
+    if (rows_since_flush_ >= 20) {
+      history_writer_.flush();
+      rows_since_flush_ = 0;
+    }
+  }
+
+  void write_snapshot() {
+    if (!config_.output.snapshots) return;
+    history_writer_.flush();
+    if (config_.output.grid_snapshots)
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &sim_.nodes());
+    else
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+  }
+
+  void write_checkpoint_file() {
+    CheckpointData<D> data;
+    data.config_toml = config_.resolved_toml;
+    data.time = sim_.time();
+    data.step = sim_.step_count();
+    data.previous_dt = last_dt_;
+    data.scalars = {{"external_work", sim_.external_work()},
+                    {"initial_energy", initial_energy_},
+                    {"snapshots_done", static_cast<double>(snapshot_.done)},
+                    {"history_done", static_cast<double>(history_.done)},
+                    {"checkpoints_done", static_cast<double>(checkpoint_.done)},
+                    {"checkpoint_index", static_cast<double>(checkpoint_index_ + 1)}};
+    data.history_columns = history_writer_.columns();
+    data.history_rows = history_writer_.rows();
+    data.snapshot_entries = snapshots_.entries();
+    data.snapshot_next_index = snapshots_.next_index();
+    data.particles = sim_.particles();
+    last_checkpoint_ = dir_ / fmt::format("checkpoint-{:04d}.h5", checkpoint_index_++);
+    write_checkpoint<D>(last_checkpoint_, data);
+  }
+
+  [[noreturn]] void fail(const SimulationFailure& f) {
+    history_writer_.flush();
+    std::string saved;
+    try {
+      SnapshotWriter<D> failure(dir_, "failure");
+      failure.write(sim_.particles(), sim_.time(), sim_.step_count());
+      saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
+    } catch (const std::exception&) {
+      saved = "; the failed state could not be written";
+    }
+    finish_progress();
+    throw RunFailure(fmt::format("simulation failed at step {} (t = {:.6g}): {}{}; the last good "
+                                 "output is in {}",
+                                 sim_.step_count() + 1, sim_.time(), f.what(), saved, dir_.string()));
+  }
+
+  void progress(Clock::time_point start, long long first_step) {
+    if (options_.quiet) return;
+    const auto now = Clock::now();
+    const double end = config_.simulation.end_time;
+    const double frac = std::min(1.0, sim_.time() / end);
+    if (isatty(fileno(stderr))) {
+      if (now - last_progress_ < std::chrono::milliseconds(250)) return;
+      last_progress_ = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(sim_.particles().n()) / elapsed : 0.0;
+      const double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
+      std::fprintf(stderr, "\r  step %lld  t = %.4g  %5.1f%%  ETA %6.1f s  %.3g particle-steps/s   ",
+                   sim_.step_count(), sim_.time(), 100.0 * frac, eta, rate);
+      progress_shown_ = true;
+    } else {
+      const int decile = static_cast<int>(10.0 * frac);
+      if (decile > last_decile_) {
+        last_decile_ = decile;
+        std::fprintf(stderr, "  step %lld  t = %.6g  (%d%%)\n", sim_.step_count(), sim_.time(), 10 * decile);
+      }
+    }
+  }
+
+  void finish_progress() {
+    if (progress_shown_) std::fprintf(stderr, "\n");
+    progress_shown_ = false;
+  }
+
+  Config config_;
+  RunOptions options_;
+  Simulation<D> sim_;
+  std::filesystem::path dir_;
+  Schedule history_, snapshot_, checkpoint_;
+  HistoryWriter history_writer_{dir_ / "history.csv", history_columns};
+  SnapshotWriter<D> snapshots_;
+  double initial_energy_ = 0.0;
+  double last_dt_ = 0.0;
+  int checkpoint_index_ = 0;
+  int rows_since_flush_ = 0;
+  bool restarted_ = false;
+  std::filesystem::path last_checkpoint_;
+  Clock::time_point last_progress_{};
+  int last_decile_ = 0;
+  bool progress_shown_ = false;
+};
+
+template <int D>
+RunSummary run_dim(const Config& config, const RunOptions& options, const CheckpointData<D>* from) {
+  Runner<D> runner(config, options);
+  if (from) runner.restore(*from);
+  return runner.run();
+}
+
+}  // namespace
+
+RunSummary run(const Config& config, const RunOptions& options) {
+  switch (config.simulation.dimension) {
+    case 1: return run_dim<1>(config, options, nullptr);
+    case 2: return run_dim<2>(config, options, nullptr);
+    default: return run_dim<3>(config, options, nullptr);
+  }
+}
+
+namespace {
+template <int D>
+RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                       const RunOptions& options) {
+  const CheckpointData<D> data = read_checkpoint<D>(file);
+  const Config config = load_config_string(data.config_toml, file.string(), overrides);
+  if (config.simulation.dimension != D)
+    throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+  return run_dim<D>(config, options, &data);
+}
+}  // namespace
+
+RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
+                   const RunOptions& options) {
+  switch (checkpoint_dimension(checkpoint)) {
+    case 1: return restart_dim<1>(checkpoint, overrides, options);
+    case 2: return restart_dim<2>(checkpoint, overrides, options);
+    default: return restart_dim<3>(checkpoint, overrides, options);
+  }
+}
+
+}  // namespace cairn

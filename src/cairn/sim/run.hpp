@@ -1,0 +1,43 @@
+// The run loop: time stepping to end_time with the output schedule (history rows, HDF5/XDMF
+// snapshots, checkpoints), a progress line, failure handling and restart from a checkpoint.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cairn/io/config.hpp"
+
+namespace cairn {
+
+struct RunOptions {
+  bool quiet = false;  ///< no progress line and no summary
+};
+
+struct RunSummary {
+  long long steps = 0;      ///< steps taken by this invocation
+  double end_time = 0.0;    ///< simulated time reached
+  double wall_seconds = 0.0;
+  double particle_steps_per_second = 0.0;
+  std::size_t n_particles = 0;
+  std::filesystem::path output_directory;
+  std::filesystem::path last_checkpoint;
+};
+
+/// A run stopped by a SimulationFailure, with the step and time at which it happened. The last
+/// good history, snapshots and checkpoints are on disk, plus a `failure` snapshot of the state
+/// that failed.
+class RunFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Run a validated config from t = 0 (dispatches on simulation.dimension).
+RunSummary run(const Config& config, const RunOptions& options);
+
+/// Continue from a checkpoint written by run(); `overrides` (`--set`) apply to the stored input.
+/// A restart without overrides ends bit-identical to the run that never stopped.
+RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
+                   const RunOptions& options);
+
+}  // namespace cairn
