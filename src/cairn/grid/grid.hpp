@@ -60,6 +60,20 @@ class Grid {
     return idx;
   }
 
+  /// Contribution of axis `a`, multi-index component j, to the storage index (wrapping a
+  /// periodic axis); -1 when j lies beyond the stored ghost layers. The storage index of a node
+  /// is the sum of its axes' contributions.
+  [[nodiscard]] std::int32_t axis_index(int a, int j) const {
+    if (periodic_[a]) {
+      j %= n_cells_[a];
+      if (j < 0) j += n_cells_[a];
+    } else {
+      j += offset_[a];
+      if (j < 0 || j >= stored_[a]) return -1;
+    }
+    return j * stride_[a];
+  }
+
   /// Multi-index (domain numbering, may be negative for ghost nodes) of a stored node.
   [[nodiscard]] IVec<D> multi_index(std::int32_t idx) const {
     IVec<D> j;

@@ -5,20 +5,21 @@
 
 #include <fmt/format.h>
 
+#include <toml++/toml.h>
+
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <climits>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "cairn/io/schema.hpp"
 #include "cairn/materials/material.hpp"
@@ -253,7 +254,6 @@ class TableReader {
   }
   [[nodiscard]] bool present(const std::string& name) const { return given(name) != nullptr; }
   [[nodiscard]] Path path_of(const std::string& name) const { return child(path_, name); }
-  [[nodiscard]] const toml::table* table() const { return table_; }
 
   [[nodiscard]] double real(const std::string& name);
   [[nodiscard]] long long integer(const std::string& name);

@@ -51,25 +51,30 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
         hi_t[a] = std::max(hi_t[a], first[a] + width - 1 - cell[a] - 1);
       }
       cache.cell[p] = cell;
+      // Per-axis storage offsets of the stencil nodes (-1: beyond the ghost layers).
+      std::array<std::array<std::int32_t, max_width>, D> offset{};
+      for (int a = 0; a < D; ++a)
+        for (int k = 0; k < width; ++k) offset[a][k] = grid.axis_index(a, first[a] + k);
       const std::size_t base = static_cast<std::size_t>(p) * slots;
       int used = 0;
-      IVec<D> k = IVec<D>::Zero();
+      std::array<int, D> k{};  // odometer over the width^D box, axis 0 fastest
       for (int s = 0; s < slots; ++s) {
-        // k = multi-index of slot s within the width^D box
-        int rem = s;
-        for (int a = 0; a < D; ++a) {
-          k[a] = rem % width;
-          rem /= width;
-        }
         double S = 1.0;
         Vec<D> G = Vec<D>::Ones();
+        std::int32_t idx = 0;
+        bool outside = false;
         for (int a = 0; a < D; ++a) {
           S *= w[a][k[a]];
           for (int b = 0; b < D; ++b) G[b] *= (a == b) ? dw[a][k[a]] * inv_h[a] : w[a][k[a]];
+          outside |= offset[a][k[a]] < 0;
+          idx += offset[a][k[a]];
+        }
+        for (int a = 0; a < D; ++a) {
+          if (++k[a] < width) break;
+          k[a] = 0;
         }
         if (S == 0.0 && G.isZero(0.0)) continue;  // outside the support
-        const std::int32_t idx = grid.node_index(first + k);
-        if (idx < 0) {
+        if (outside) {
           bad_t = std::min<std::int64_t>(bad_t, p);
           continue;
         }
