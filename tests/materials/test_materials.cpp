@@ -119,3 +119,26 @@ TEST(Materials, EveryModelStressIsTheDerivativeOfItsEnergy) {
 
 }  // namespace
 }  // namespace cairn
+
+#include "cairn/materials/plane_stress.hpp"
+
+namespace cairn {
+namespace {
+
+TEST(Materials, PlaneStressSolvesForTheOutOfPlaneStretch) {
+  for (std::string model : {"linear_elastic", "neo_hookean"}) {
+    auto m = make_material(config(model, {{"youngs_modulus", 1e6}, {"poissons_ratio", 0.3}}, model == "neo_hookean" ? "ln_j" : ""));
+    Mat3 F = Mat3::Identity();
+    F(0, 0) = 1.001;  // uniaxial stress along x: sigma_yy = sigma_zz = 0 needs F_yy = F_zz
+    F(1, 1) = 1.0 - 0.3 * 0.001;
+    const Mat3 L = Mat3::Zero();
+    const MaterialPoint point{F, L, nullptr, 0.0};
+    const Mat3 tau = plane_stress_update(*m, F, point);
+    EXPECT_NEAR(tau(2, 2), 0.0, 1e-6) << model;
+    EXPECT_NEAR(F(2, 2), F(1, 1), 2e-6) << model;  // same lateral contraction (small strain)
+    EXPECT_NEAR(tau(0, 0) / F.determinant(), 1e6 * 0.001, 2e-3 * 1e3) << model;  // sigma = E eps
+  }
+}
+
+}  // namespace
+}  // namespace cairn

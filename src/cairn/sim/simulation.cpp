@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cairn/materials/plane_stress.hpp"
 #include "cairn/math/tensor.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
@@ -29,22 +30,6 @@ T chunked_sum(std::int64_t n, T zero, Fn&& term) {
   T total = zero;
   for (const auto& s : partial) total += s;
   return total;
-}
-
-/// Plane stress: find F_zz such that tau_zz = 0 (Newton with a finite-difference slope).
-Mat3 plane_stress_update(const Material& m, Mat3& F, const MaterialPoint& point) {
-  Mat3 tau = m.update(point);
-  const double scale = std::max(1.0, tau.norm());
-  for (int it = 0; it < 25 && std::abs(tau(2, 2)) > 1e-13 * scale; ++it) {
-    const double fzz = F(2, 2), delta = 1e-7 * std::max(1.0, std::abs(fzz));
-    F(2, 2) = fzz + delta;
-    const double t_plus = m.update(point)(2, 2);
-    const double slope = (t_plus - tau(2, 2)) / delta;
-    if (slope == 0.0) break;
-    F(2, 2) = fzz - tau(2, 2) / slope;
-    tau = m.update(point);
-  }
-  return tau;
 }
 
 }  // namespace
