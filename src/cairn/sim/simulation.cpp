@@ -51,7 +51,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   double max_mass = 0.0;
   for (double m : particles_.mass) max_mass = std::max(max_mass, m);
   small_mass_ = 1e-15 * max_mass;  // nodes below this hold no velocity
-  setup_boundary_conditions();
+  conditions_ = GridConditions<D>(config_.boundary, grid_);
 
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
@@ -80,31 +80,6 @@ void Simulation<D>::setup_grid() {
     periodic[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
   grid_ = Grid<D>(origin, n_cells, h, shape_->ghost_layers(), periodic);
-}
-
-template <int D>
-void Simulation<D>::setup_boundary_conditions() {
-  // Fixed faces hold every component at zero on the face nodes and the ghost nodes beyond them;
-  // symmetry faces hold the normal component only.
-  bc_nodes_.clear();
-  bc_mask_.clear();
-  for (std::int32_t i = 0; i < grid_.n_nodes(); ++i) {
-    const IVec<D> j = grid_.multi_index(i);
-    std::uint8_t mask = 0;
-    for (int a = 0; a < D; ++a) {
-      for (int side = 0; side < 2; ++side) {
-        const FaceCondition c = config_.boundary.face[2 * a + side];
-        const bool beyond = side == 0 ? j[a] <= 0 : j[a] >= grid_.n_cells()[a];
-        if (!beyond || c == FaceCondition::free || c == FaceCondition::periodic) continue;
-        mask |= (c == FaceCondition::fixed) ? static_cast<std::uint8_t>((1u << D) - 1u)
-                                            : static_cast<std::uint8_t>(1u << a);
-      }
-    }
-    if (mask) {
-      bc_nodes_.push_back(i);
-      bc_mask_.push_back(mask);
-    }
-  }
 }
 
 template <int D>
@@ -190,22 +165,6 @@ void Simulation<D>::particles_to_grid() {
 }
 
 template <int D>
-void Simulation<D>::apply_velocity_conditions(std::vector<Vec<D>>& v, std::vector<Vec<D>>* reaction,
-                                              double dt) {
-  const auto n = static_cast<std::int64_t>(bc_nodes_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < n; ++k) {
-    const std::int32_t i = bc_nodes_[k];
-    for (int a = 0; a < D; ++a) {
-      if (!(bc_mask_[k] & (1u << a))) continue;
-      // seed 000 Sec. 2.4: a^(b) dt = (v^(b) - v^UL . n) n, reaction m a^(b)
-      if (reaction) (*reaction)[i][a] += nodes_.mass[i] * (0.0 - v[i][a]) / dt;
-      v[i][a] = 0.0;
-    }
-  }
-}
-
-template <int D>
 void Simulation<D>::update_grid(double dt) {
   // Task 3 with the lumped mass: v = m^-1 p, p+ = p + f dt, v+ = m^-1 p+.
   for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
@@ -218,12 +177,11 @@ void Simulation<D>::update_grid(double dt) {
       nodes_.velocity_new[i].setZero();
     }
   });
-  apply_velocity_conditions(nodes_.velocity, nullptr, dt);
-  apply_velocity_conditions(nodes_.velocity_new, &nodes_.reaction, dt);
+  conditions_.apply_step(nodes_, dt);
 
   // External work of this step: body forces and reactions at the mean grid velocity.
   const bool has_body_force = !body_force_.empty();
-  if (has_body_force || !bc_nodes_.empty()) {
+  if (has_body_force || !conditions_.empty()) {
     external_work_ += dt * chunked_sum<double>(grid_.n_nodes(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
       double w = nodes_.reaction[i].dot(v_mean);

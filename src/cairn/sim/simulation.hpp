@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/bc/grid_conditions.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
 #include "cairn/materials/material.hpp"
@@ -67,8 +68,6 @@ class Simulation {
 
  private:
   void setup_grid();
-  void setup_boundary_conditions();
-  void apply_velocity_conditions(std::vector<Vec<D>>& v, std::vector<Vec<D>>* reaction, double dt);
   void compute_body_forces();
   Mat3 stress_for(std::size_t p, const Mat3& L, double dt);
 
@@ -86,8 +85,7 @@ class Simulation {
   bool body_force_constant_ = false;
   Vec<D> body_force_value_ = Vec<D>::Zero();
   std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step
-  std::vector<std::int32_t> bc_nodes_;     ///< nodes with velocity conditions
-  std::vector<std::uint8_t> bc_mask_;      ///< bit a set: component a is held at zero
+  GridConditions<D> conditions_;           ///< velocity conditions from [boundary]
   double small_mass_ = 0.0;
   double time_ = 0.0;
   long long step_ = 0;
