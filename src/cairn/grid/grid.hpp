@@ -119,6 +119,8 @@ struct NodeField {
   std::vector<Vec<D>> velocity;      ///< v_i = m^-1 p (after velocity conditions)
   std::vector<Vec<D>> velocity_new;  ///< v_i^+ = m^-1 p^+ (after velocity conditions)
   std::vector<Vec<D>> reaction;      ///< force exerted by velocity conditions on the node
+  std::vector<Vec<D>> velocity_full; ///< m~_k^-1 q from the full-mass expansion (FMPM/XPIC)
+  std::vector<Vec<D>> velocity_work; ///< scratch: projections, re-extrapolated velocities
 
   void resize(std::int32_t n) {
     mass.assign(n, 0.0);
@@ -127,6 +129,8 @@ struct NodeField {
     velocity.assign(n, Vec<D>::Zero());
     velocity_new.assign(n, Vec<D>::Zero());
     reaction.assign(n, Vec<D>::Zero());
+    velocity_full.assign(n, Vec<D>::Zero());
+    velocity_work.assign(n, Vec<D>::Zero());
   }
 };
 

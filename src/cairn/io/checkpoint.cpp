@@ -56,7 +56,8 @@ void check_particles(const Particles<D>& ps) {
   const bool ok = ps.reference_position.size() == n && ps.velocity.size() == n &&
                   ps.mass.size() == n && ps.volume0.size() == n && ps.size0.size() == n &&
                   ps.deformation_gradient.size() == n && ps.kirchhoff_stress.size() == n &&
-                  ps.velocity_gradient.size() == n && ps.material.size() == n &&
+                  ps.velocity_gradient.size() == n && ps.affine_velocity.size() == n &&
+                  ps.material.size() == n &&
                   ps.body.size() == n && ps.n_state_per_particle >= 0 &&
                   ps.state.size() == n * static_cast<std::size_t>(ps.n_state_per_particle);
   if (!ok) throw std::invalid_argument("write_checkpoint: particle arrays have inconsistent lengths");
@@ -172,6 +173,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
       write_mats(gid, "deformation_gradient", ps.deformation_gradient);
       write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
       write_mats(gid, "velocity_gradient", ps.velocity_gradient);
+      write_mats(gid, "affine_velocity", ps.affine_velocity);
       h5::write_ints(gid, "material", ps.material.data(), n);
       h5::write_ints(gid, "body", ps.body.data(), n);
       h5::write_doubles(gid, "state", ps.state.data(), ps.state.size());
@@ -242,6 +244,7 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
     ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
     ps.kirchhoff_stress = read_mats(gid, "kirchhoff_stress", n);
     ps.velocity_gradient = read_mats(gid, "velocity_gradient", n);
+    ps.affine_velocity = read_mats(gid, "affine_velocity", n);
     ps.material = h5::read_ints(gid, "material", n);
     ps.body = h5::read_ints(gid, "body", n);
     ps.state = h5::read_doubles(gid, "state", {n * static_cast<std::size_t>(n_state)});

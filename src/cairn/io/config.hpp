@@ -46,6 +46,14 @@ struct MethodConfig {
   int order = 1;
   std::string stress_update = "usl";
   double smoothing_length = 0.0;  ///< uGIMP l; 0 = the initial particle size
+  double cpdi_max_span = 2.0;     ///< CPDI guard: widest domain (cells per axis) before falling back to GIMP
+  double beta = 0.99;             ///< FLIP fraction of the blend update (seed 002 Eq. 1.79)
+  std::string blend_position = "grid";  ///< grid: VV = S v; projected: beta S v + (1-beta) P V
+  double grid_damping = 0.0;      ///< alpha_g (seed 002 Eq. 1.83)
+  double particle_damping = 0.0;  ///< alpha_p (seed 002 Eq. 1.83)
+  double full_mass_cfl = 0.0;     ///< periodic FMPM/XPIC CFL_X; 0 = every step
+  std::string velocity_bc_method = "combined";  ///< FMPM velocity conditions: velocity|lumped|combined
+  std::string time_integration = "forward_euler";  ///< or central_difference
 };
 
 /// A material's parameters after validation against the model's declared keys (defaults filled).
@@ -80,11 +88,15 @@ struct BodyConfig {
 };
 
 enum class FaceCondition { free, fixed, symmetry, periodic };
+enum class BoundaryAcceleration { zero, velocity_change };
 
 struct BoundaryConfig {
   /// Index 2*axis + side (side 0 = min face, 1 = max face).
   std::array<FaceCondition, 6> face{FaceCondition::free, FaceCondition::free, FaceCondition::free,
                                     FaceCondition::free, FaceCondition::free, FaceCondition::free};
+  /// Acceleration seen by the particle update at constrained nodes: zero (both grid velocities
+  /// constrained) or from the velocity change (seed 003 Eq. 30).
+  BoundaryAcceleration acceleration = BoundaryAcceleration::zero;
 };
 
 struct BodyForceConfig {

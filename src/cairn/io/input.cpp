@@ -808,6 +808,14 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.order = r.small_integer("order");
   m.stress_update = r.string("stress_update");
   m.smoothing_length = r.real("smoothing_length");
+  m.cpdi_max_span = r.real("cpdi_max_span");
+  m.beta = r.real("beta");
+  m.blend_position = r.string("blend_position");
+  m.grid_damping = r.real("grid_damping");
+  m.particle_damping = r.real("particle_damping");
+  m.full_mass_cfl = r.real("full_mass_cfl");
+  m.velocity_bc_method = r.string("velocity_bc_method");
+  m.time_integration = r.string("time_integration");
 }
 
 void Loader::read_constants(const toml::table& root, Config& cfg) {
@@ -1024,6 +1032,9 @@ void Loader::read_boundary(const toml::table& root, Config& cfg) {
     for (int k = 0; k < 4; ++k)
       if (c == face_condition_names[k]) cfg.boundary.face[f] = static_cast<FaceCondition>(k);
   }
+  cfg.boundary.acceleration = r.string("acceleration") == "velocity_change"
+                                  ? BoundaryAcceleration::velocity_change
+                                  : BoundaryAcceleration::zero;
   for (int a = 0; a < dim_; ++a) {
     const bool lo = cfg.boundary.face[2 * a] == FaceCondition::periodic;
     const bool hi = cfg.boundary.face[2 * a + 1] == FaceCondition::periodic;
@@ -1150,6 +1161,14 @@ std::string config_to_toml(const Config& c) {
   line("order", fmt::format("{}", m.order));
   line("stress_update", toml_string(m.stress_update));
   line("smoothing_length", real_text(m.smoothing_length));
+  line("cpdi_max_span", real_text(m.cpdi_max_span));
+  line("beta", real_text(m.beta));
+  line("blend_position", toml_string(m.blend_position));
+  line("grid_damping", real_text(m.grid_damping));
+  line("particle_damping", real_text(m.particle_damping));
+  line("full_mass_cfl", real_text(m.full_mass_cfl));
+  line("velocity_bc_method", toml_string(m.velocity_bc_method));
+  line("time_integration", toml_string(m.time_integration));
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";
@@ -1189,6 +1208,8 @@ std::string config_to_toml(const Config& c) {
   o += "\n[boundary]\n";
   for (int f = 0; f < 2 * s.dimension && f < 6; ++f)
     line(face_names[f], toml_string(face_condition_names[static_cast<int>(c.boundary.face[f])]));
+  line("acceleration", toml_string(c.boundary.acceleration == BoundaryAcceleration::zero ? "zero"
+                                                                                  : "velocity_change"));
 
   if (!c.body_force.expression.empty()) {
     o += "\n[body_force]\n";

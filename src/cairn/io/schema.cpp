@@ -15,6 +15,7 @@ namespace cairn {
 namespace {
 
 std::vector<std::string> face_conditions() { return {"free", "fixed", "symmetry", "periodic"}; }
+std::vector<std::string> boundary_acceleration_names() { return {"zero", "velocity_change"}; }
 std::vector<std::string> mode_names() { return {"plane_strain", "plane_stress", "3d", "uniaxial"}; }
 
 /// Fluent construction of a KeyDecl (designated initializers that skip members warn under -Wextra).
@@ -127,9 +128,47 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("\"usl\"")
                 .choices(stress_update_names));
   k.push_back(Key("method", "smoothing_length", T::real,
-                 "uGIMP half-width l; 0 = the initial particle size.")
+                 "uGIMP smoothing length l (full width of the particle function); 0 = the "
+                 "initial particle size.")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("method", "cpdi_max_span", T::real,
+                 "CPDI/B2CPDI guard: a particle whose deformed domain spans more than this many "
+                 "cells along an axis uses the GIMP weights of its undeformed box for that step.")
+                .by_default("2.0")
+                .min(above_zero));
+  k.push_back(Key("method", "beta", T::real,
+                 "FLIP fraction beta of the `blend` update (seed 002 Eq. 1.79).")
+                .by_default("0.99")
+                .min(0.0)
+                .max(1.0));
+  k.push_back(Key("method", "blend_position", T::string,
+                 "Effective velocity of the `blend` update: grid = S v, projected = "
+                 "beta S v + (1 - beta) P V (seed 002 Eq. 1.80).")
+                .by_default("\"grid\"")
+                .choices([] { return std::vector<std::string>{"grid", "projected"}; }));
+  k.push_back(Key("method", "grid_damping", T::real,
+                 "Grid damping alpha_g in 1/time (seed 002 Eq. 1.83).")
+                .by_default("0.0"));
+  k.push_back(Key("method", "particle_damping", T::real,
+                 "Particle damping alpha_p in 1/time (seed 002 Eq. 1.83).")
+                .by_default("0.0"));
+  k.push_back(Key("method", "full_mass_cfl", T::real,
+                 "Periodic FMPM/XPIC: full-mass steps only every CFL_X h / c of time, FLIP "
+                 "steps between (seed 000 Sec. 3.1); 0 = every step.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("method", "velocity_bc_method", T::string,
+                 "How FMPM/XPIC impose grid velocity conditions (seed 000 Sec. 2.4): velocity, "
+                 "lumped or combined.")
+                .by_default("\"combined\"")
+                .choices([] { return std::vector<std::string>{"velocity", "lumped", "combined"}; }));
+  k.push_back(Key("method", "time_integration", T::string,
+                 "forward_euler (seed 003 Eq. 6-10) or central_difference: velocities at half "
+                 "steps, started by half the first acceleration (seed 003 Eq. 11-15, seed 001 "
+                 "Sec. 4.7).")
+                .by_default("\"forward_euler\"")
+                .choices([] { return std::vector<std::string>{"forward_euler", "central_difference"}; }));
 
   // [[material]] (the model's own keys come from material_model_info())
   k.push_back(Key("material", "name", T::string,
@@ -220,6 +259,12 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("\"free\"")
                 .choices(face_conditions));
   }
+  k.push_back(Key("boundary", "acceleration", T::string,
+                 "Acceleration at nodes held by fixed and symmetry faces: zero (both grid "
+                 "velocities held) or velocity_change (seed 003 Eq. 30: from the projected "
+                 "velocity to the held one).")
+                .by_default("\"zero\"")
+                .choices(boundary_acceleration_names));
 
   // [body_force]
   k.push_back(Key("body_force", "expression", T::expression_array,
@@ -375,7 +420,11 @@ const std::vector<SectionDoc>& section_docs() {
        "displacement = [\"A*sin(2*_pi*X)\", \"0\"]\n"},
       {"boundary", "[boundary]",
        "Conditions on the faces of the grid. A periodic axis needs periodic on both of its faces; "
-       "y_* and z_* keys exist only in 2D and 3D, z_* only in 3D.",
+       "y_* and z_* keys exist only in 2D and 3D, z_* only in 3D. fixed holds every velocity "
+       "component at zero on the face nodes and the ghost nodes beyond; symmetry holds the normal "
+       "component on the face and mirrors ghost nodes (normal component negated); with the "
+       "open-knot families (bspline2_open, bspline3_open) only the face value, whose basis "
+       "function is the only one non-zero on the face, is held. See docs/shape-functions.md.",
        "[boundary]\n"
        "x_min = \"fixed\"\n"
        "x_max = \"free\"\n"

@@ -22,6 +22,7 @@ struct Particles {
   std::vector<Mat3> deformation_gradient;  ///< F (3x3 always)
   std::vector<Mat3> kirchhoff_stress;   ///< tau = J sigma (3x3 always)
   std::vector<Mat3> velocity_gradient;  ///< last grad V_p extrapolated from the grid (diagnostic)
+  std::vector<Mat3> affine_velocity;    ///< APIC affine matrix C_p (top-left DxD used; else zero)
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
@@ -40,6 +41,7 @@ struct Particles {
     deformation_gradient.resize(n, Mat3::Identity());
     kirchhoff_stress.resize(n, Mat3::Zero());
     velocity_gradient.resize(n, Mat3::Zero());
+    affine_velocity.resize(n, Mat3::Zero());
     material.resize(n);
     body.resize(n);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
@@ -57,6 +59,7 @@ struct Particles {
     deformation_gradient.push_back(Mat3::Identity());
     kirchhoff_stress.push_back(Mat3::Zero());
     velocity_gradient.push_back(Mat3::Zero());
+    affine_velocity.push_back(Mat3::Zero());
     material.push_back(mat);
     body.push_back(bod);
     state.resize(state.size() + static_cast<std::size_t>(n_state_per_particle), 0.0);

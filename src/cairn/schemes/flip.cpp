@@ -1,7 +1,13 @@
-// Standard FLIP with the second-order position update (seed 000 Task 4, seed 002 Eq. 1.58):
-//     A dt = S m^-1 f dt = S (v+ - v),    VV = S m^-1 p = S v.
+// FLIP updates (P = I, seed 002 Sec. 1.4.2):
+//  flip       A dt = S a dt, VV = S v: standard FLIP, second-order position update (seed 000
+//             Task 4, seed 002 Eq. 1.58 first form)
+//  flip1      A dt = S a dt, VV = S v + 1/2 S a dt: "modified FLIP #1", X += S v~ dt
+//             (seed 002 Eq. 1.60-1.62; seed 003 Eq. 9-10)
+//  flip2      A dt = S a dt, VV = V + 1/2 S a dt: "modified FLIP #2", X += V^(n+1) dt
+//             (seed 002 Eq. 1.63-1.65)
+//  flip_vv    A dt = S a dt, VV = V: midpoint update with the particle velocity (seed 002
+//             Sec. 1.3.1, Eq. 1.58 second form) -- known to be poor, kept for comparison
 #include "cairn/schemes/scheme.hpp"
-#include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
 namespace {
@@ -10,25 +16,39 @@ template <int D>
 class Flip final : public UpdateScheme<D> {
  public:
   explicit Flip(const MethodConfig&) {}
-  void update_particles(StepState<D>& step) const override {
-    const auto& c = step.cache;
-    const auto& v = step.nodes.velocity;
-    const auto& v_new = step.nodes.velocity_new;
-    const double dt = step.dt;
-    auto& P = step.particles;
-    gather(c, [&](std::int64_t p, std::size_t begin, std::size_t end) {
-      Vec<D> a_dt = Vec<D>::Zero(), vv = Vec<D>::Zero();
-      for (std::size_t s = begin; s < end; ++s) {
-        const std::int32_t i = c.node[s];
-        a_dt += c.weight[s] * (v_new[i] - v[i]);
-        vv += c.weight[s] * v[i];
-      }
-      P.velocity[p] += a_dt;
-      P.position[p] += vv * dt + 0.5 * a_dt * dt;
-    });
+  Effective<D> effective(const GridAtParticle<D>& g) const override { return {g.Sv_new - g.Sv, g.Sv}; }
+};
+
+template <int D>
+class FlipFirstOrder final : public UpdateScheme<D> {
+ public:
+  explicit FlipFirstOrder(const MethodConfig&) {}
+  Effective<D> effective(const GridAtParticle<D>& g) const override {
+    const Vec<D> a_dt = g.Sv_new - g.Sv;
+    return {a_dt, g.Sv + 0.5 * a_dt};
   }
 };
 
+template <int D>
+class FlipParticleEnd final : public UpdateScheme<D> {
+ public:
+  explicit FlipParticleEnd(const MethodConfig&) {}
+  Effective<D> effective(const GridAtParticle<D>& g) const override {
+    const Vec<D> a_dt = g.Sv_new - g.Sv;
+    return {a_dt, g.V + 0.5 * a_dt};
+  }
+};
+
+template <int D>
+class FlipParticleVelocity final : public UpdateScheme<D> {
+ public:
+  explicit FlipParticleVelocity(const MethodConfig&) {}
+  Effective<D> effective(const GridAtParticle<D>& g) const override { return {g.Sv_new - g.Sv, g.V}; }
+};
+
 }  // namespace
-CAIRN_REGISTER_SCHEME(Flip, "flip", "FLIP, second-order position update (seed 000 Task 4)");
+CAIRN_REGISTER_SCHEME(Flip, "flip", "FLIP, VV = S v, second-order position update (seed 000 Task 4)");
+CAIRN_REGISTER_SCHEME(FlipFirstOrder, "flip1", "FLIP with X += S v+ dt (seed 002 Eq. 1.60-1.61)");
+CAIRN_REGISTER_SCHEME(FlipParticleEnd, "flip2", "FLIP with X += V(n+1) dt (seed 002 Eq. 1.63-1.64)");
+CAIRN_REGISTER_SCHEME(FlipParticleVelocity, "flip_vv", "FLIP with VV = V (seed 002 Sec. 1.3.1)");
 }  // namespace cairn

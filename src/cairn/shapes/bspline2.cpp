@@ -8,17 +8,7 @@ template <int D>
 struct QuadraticSplineKernel {
   int width(const Particles<D>&) const { return 3; }
   int eval(const Particles<D>&, std::size_t, int, double xi, double* w, double* dw) const {
-    // Nearest node c = round(xi); d = xi - c in [-1/2, 1/2). Seed 003 Eq. 21 evaluated at the
-    // three nodes c-1, c, c+1 (distances d+1, d, d-1).
-    const double c = std::floor(xi + 0.5);
-    const double d = xi - c;
-    w[0] = 0.5 * (0.5 - d) * (0.5 - d);
-    w[1] = 0.75 - d * d;
-    w[2] = 0.5 * (0.5 + d) * (0.5 + d);
-    dw[0] = d - 0.5;
-    dw[1] = -2.0 * d;
-    dw[2] = d + 0.5;
-    return static_cast<int>(c) - 1;
+    return quadratic_spline_weights(xi, w, dw);
   }
 };
 

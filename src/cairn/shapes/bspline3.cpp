@@ -9,18 +9,7 @@ template <int D>
 struct CubicSplineKernel {
   int width(const Particles<D>&) const { return 4; }
   int eval(const Particles<D>&, std::size_t, int, double xi, double* w, double* dw) const {
-    const double f = std::floor(xi);
-    const double t = xi - f;  // nodes f-1, f, f+1, f+2
-    const double u = 1.0 - t;
-    w[0] = u * u * u / 6.0;
-    w[1] = (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0;
-    w[2] = (-3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0) / 6.0;
-    w[3] = t * t * t / 6.0;
-    dw[0] = -0.5 * u * u;
-    dw[1] = (9.0 * t * t - 12.0 * t) / 6.0;
-    dw[2] = (-9.0 * t * t + 6.0 * t + 3.0) / 6.0;
-    dw[3] = 0.5 * t * t;
-    return static_cast<int>(f) - 1;
+    return cubic_spline_weights(xi, w, dw);
   }
 };
 

@@ -20,12 +20,33 @@ struct ShapeContext {
   int dimension;
 };
 
+/// How a family's grid values meet the non-periodic domain faces; velocity conditions
+/// (bc/grid_conditions) act accordingly.
+enum class FaceBasis {
+  /// One value per grid node. Wide stencils reach ghost nodes beyond the faces (seed 003
+  /// Sec. 3.4.2): Dirichlet faces hold them too, symmetry faces mirror them.
+  ghost_nodes,
+  /// Open-knot boundary B-splines (seed 003 Eq. 22-23): the value stored at the face node belongs
+  /// to the only basis function that is non-zero on the face (it equals 1 there), so a condition
+  /// on that value alone holds exactly on the whole face. Ghost slots hold the extra interior
+  /// functions of the open knot vector and are never constrained.
+  open_knot,
+};
+
 template <int D>
 class ShapeFamily {
  public:
   virtual ~ShapeFamily() = default;
   /// Ghost node layers the family needs beyond each non-periodic domain face.
   [[nodiscard]] virtual int ghost_layers() const = 0;
+  /// How the family's values relate to the faces (default: ghost nodes).
+  [[nodiscard]] virtual FaceBasis face_basis() const { return FaceBasis::ghost_nodes; }
+  /// Position of the degree of freedom stored at node `index`: the node itself for nodal
+  /// families, the Greville abscissa (knot average) for open-knot splines. sum_i S_pi x_i = x_p
+  /// holds with these positions; tests and plots use it.
+  [[nodiscard]] virtual Vec<D> dof_position(const Grid<D>& grid, std::int32_t index) const {
+    return grid.node_position(index);
+  }
   /// Fill cache.node/weight/gradient/count/cell and reach for every particle. Throws
   /// SimulationFailure naming the lowest-index particle whose stencil leaves the stored grid.
   virtual void build(const Grid<D>& grid, const Particles<D>& particles,

@@ -5,6 +5,9 @@
 //     int width(const Particles<D>&) const;      // max nodes per axis for this step
 //     // first node and per-axis values at particle p, axis a; xi is the position in cell units
 //     int eval(const Particles<D>&, std::size_t p, int a, double xi, double* w, double* dw) const;
+//     // optional: grid multi-index along axis a of the kernel's k-th value from `first`
+//     // (default first + k); open-knot splines store their extra functions in ghost slots
+//     int node_of(int a, int first, int k) const;
 //   };
 //
 // eval() returns the first node's multi-index along the axis and fills width() weights and
@@ -15,7 +18,10 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
+#include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -26,6 +32,11 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
                           TransferCache<D>& cache) {
   constexpr int max_width = 8;
   const int width = kernel.width(particles);
+  if (width > max_width)
+    throw std::invalid_argument("shape family: a stencil " + std::to_string(width) +
+                                " nodes wide per axis exceeds the limit of " +
+                                std::to_string(max_width) +
+                                " (smoothing length or particle size too large for the cell size)");
   int slots = 1;
   for (int a = 0; a < D; ++a) slots *= width;
   const auto n = particles.n();
@@ -47,14 +58,19 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
       for (int a = 0; a < D; ++a) {
         cell[a] = static_cast<int>(std::floor(xi[a]));
         first[a] = kernel.eval(particles, p, a, xi[a], w[a].data(), dw[a].data());
-        lo_t[a] = std::max(lo_t[a], cell[a] - first[a]);
-        hi_t[a] = std::max(hi_t[a], first[a] + width - 1 - cell[a] - 1);
       }
       cache.cell[p] = cell;
       // Per-axis storage offsets of the stencil nodes (-1: beyond the ghost layers).
       std::array<std::array<std::int32_t, max_width>, D> offset{};
       for (int a = 0; a < D; ++a)
-        for (int k = 0; k < width; ++k) offset[a][k] = grid.axis_index(a, first[a] + k);
+        for (int k = 0; k < width; ++k) {
+          int j = first[a] + k;
+          if constexpr (requires { kernel.node_of(a, first[a], k); }) j = kernel.node_of(a, first[a], k);
+          offset[a][k] = grid.axis_index(a, j);
+          if (w[a][k] == 0.0 && dw[a][k] == 0.0) continue;  // outside the support: no reach
+          lo_t[a] = std::max(lo_t[a], cell[a] - j);
+          hi_t[a] = std::max(hi_t[a], j - cell[a] - 1);
+        }
       const std::size_t base = static_cast<std::size_t>(p) * slots;
       int used = 0;
       std::array<int, D> k{};  // odometer over the width^D box, axis 0 fastest
@@ -102,15 +118,6 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
                             "particle " + std::to_string(first_bad) + " left the grid at (" +
                                 where + "): its stencil reaches beyond the ghost nodes");
   }
-}
-
-/// Hat function N(s) = max(0, 1 - |s|) (seed 003 Eq. 17) and its antiderivative from -inf.
-inline double hat(double s) { return std::max(0.0, 1.0 - std::abs(s)); }
-inline double hat_integral(double s) {
-  if (s <= -1.0) return 0.0;
-  if (s <= 0.0) return 0.5 * (s + 1.0) * (s + 1.0);
-  if (s <= 1.0) return 1.0 - 0.5 * (1.0 - s) * (1.0 - s);
-  return 1.0;
 }
 
 }  // namespace cairn

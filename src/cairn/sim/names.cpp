@@ -7,6 +7,6 @@ namespace cairn {
 
 std::vector<std::string> shape_family_names() { return ShapeRegistry<2>::instance().names(); }
 std::vector<std::string> update_scheme_names() { return SchemeRegistry<2>::instance().names(); }
-std::vector<std::string> stress_update_names() { return {"usl"}; }
+std::vector<std::string> stress_update_names() { return {"usl", "usf", "usavg", "usl+", "usavg+"}; }
 
 }  // namespace cairn

@@ -21,7 +21,7 @@ using Clock = std::chrono::steady_clock;
 
 const std::vector<std::string> history_columns = {
     "kinetic_energy", "strain_energy", "external_work", "total_energy", "energy_error",
-    "momentum_x",     "momentum_y",    "momentum_z"};
+    "dissipated_energy", "momentum_x", "momentum_y", "momentum_z"};
 
 /// Output schedule as integer counters so that output times do not drift with round-off.
 struct Schedule {
@@ -54,7 +54,8 @@ class Runner {
 
   void restore(const CheckpointData<D>& data) {
     sim_.particles() = data.particles;
-    sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"));
+    sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
+                          data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
     initial_energy_ = data.scalars.at("initial_energy");
     snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
     history_.done = static_cast<long long>(data.scalars.at("history_done"));
@@ -132,7 +133,8 @@ class Runner {
     const double total = t.kinetic_energy + t.strain_energy;
     history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_,
                             {t.kinetic_energy, t.strain_energy, sim_.external_work(), total,
-                             total - initial_energy_ - sim_.external_work(), t.momentum[0],
+                             total - initial_energy_ - sim_.external_work(),
+                             sim_.dissipated_energy(), t.momentum[0],
                              t.momentum[1], t.momentum[2]});
     ++rows_since_flush_;
     if (rows_since_flush_ >= 20) {
@@ -157,6 +159,8 @@ class Runner {
     data.step = sim_.step_count();
     data.previous_dt = last_dt_;
     data.scalars = {{"external_work", sim_.external_work()},
+                    {"dissipated_energy", sim_.dissipated_energy()},
+                    {"next_full_mass_time", sim_.next_full_mass_time()},
                     {"initial_energy", initial_energy_},
                     {"snapshots_done", static_cast<double>(snapshot_.done)},
                     {"history_done", static_cast<double>(history_.done)},

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -41,17 +42,28 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   ShapeContext ctx{config_.method, D};
   shape_ = make_shape_family<D>(ctx);
   scheme_ = SchemeRegistry<D>::instance().create("update scheme", config_.method.update, config_.method);
+  flip_ = SchemeRegistry<D>::instance().create("update scheme", "flip", config_.method);
+  const std::string& su = config_.method.stress_update;
+  timing_ = su == "usf" ? Timing::usf
+            : su == "usavg" ? Timing::usavg
+            : su == "usl+" ? Timing::usl_plus
+            : su == "usavg+" ? Timing::usavg_plus
+                             : Timing::usl;
   setup_grid();
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   nodes_.resize(grid_.n_nodes());
+  grid_term_.assign(grid_.n_nodes(), Vec<D>::Zero());
+  grid_proj_.assign(grid_.n_nodes(), Vec<D>::Zero());
+  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
+  particle_scalar_.assign(particles_.n(), 0.0);
   body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
   double max_mass = 0.0;
   for (double m : particles_.mass) max_mass = std::max(max_mass, m);
   small_mass_ = 1e-15 * max_mass;  // nodes below this hold no velocity
-  conditions_ = GridConditions<D>(config_.boundary, grid_);
+  conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
 
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
@@ -83,31 +95,105 @@ void Simulation<D>::setup_grid() {
 }
 
 template <int D>
+double Simulation<D>::max_signal_speed() const {
+  const auto n = static_cast<std::int64_t>(particles_.n());
+  double c_max = 0.0, v_max = 0.0;
+#pragma omp parallel for reduction(max : c_max, v_max)
+  for (std::int64_t p = 0; p < n; ++p) {
+    c_max = std::max(c_max, materials_[particles_.material[p]]->wave_speed(particles_.deformation_gradient[p]));
+    v_max = std::max(v_max, particles_.velocity[p].norm());
+  }
+  return c_max + v_max;
+}
+
+template <int D>
 double Simulation<D>::next_dt() const {
   const auto& s = config_.simulation;
   double dt = s.fixed_dt;
-  if (dt <= 0.0) {
-    const auto n = static_cast<std::int64_t>(particles_.n());
-    double c_max = 0.0, v_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v_max)
-    for (std::int64_t p = 0; p < n; ++p) {
-      c_max = std::max(c_max, materials_[particles_.material[p]]->wave_speed(particles_.deformation_gradient[p]));
-      v_max = std::max(v_max, particles_.velocity[p].norm());
-    }
-    dt = s.cfl * grid_.min_cell_size() / (c_max + v_max);  // seed 001 Eq. 34
-  }
+  if (dt <= 0.0) dt = s.cfl * grid_.min_cell_size() / max_signal_speed();  // seed 001 Eq. 34
   const double remaining = s.end_time - time_;
   if (remaining > 0.0 && dt > remaining) dt = remaining;
   return dt;
 }
 
+namespace {
+using StageClock = std::chrono::steady_clock;
+const char* const stage_names[] = {"stencils", "particles_to_grid", "grid_update",
+                                   "full_mass",  "particle_update",   "stress_update"};
+}  // namespace
+
+template <int D>
+std::vector<std::pair<std::string, double>> Simulation<D>::stage_times() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (std::size_t k = 0; k < stage_seconds_.size(); ++k) out.emplace_back(stage_names[k], stage_seconds_[k]);
+  return out;
+}
+
 template <int D>
 void Simulation<D>::step(double dt) {
+  auto clock = StageClock::now();
+  auto lap = [&](int stage) {
+    const auto now = StageClock::now();
+    stage_seconds_[stage] += std::chrono::duration<double>(now - clock).count();
+    clock = now;
+  };
+  const FullMass need = scheme_->full_mass();
+  use_full_mass_ = need != FullMass::none;
+  if (use_full_mass_ && config_.method.full_mass_cfl > 0.0) {
+    // Periodic FMPM/XPIC (seed 000 Sec. 3.1): full-mass steps every CFL_X h / c, FLIP between.
+    use_full_mass_ = time_ >= next_full_mass_time_ * (1.0 - 1e-12);
+    if (use_full_mass_)
+      next_full_mass_time_ = time_ + config_.method.full_mass_cfl * grid_.min_cell_size() / max_signal_speed();
+  }
+  const bool fmpm_velocities = use_full_mass_ && need == FullMass::of_updated;
+  const int k = config_.method.order;
+  step_dt_ = dt;
+
   build_stencils();
-  particles_to_grid();
+  lap(0);
+  const bool stress_first = timing_ == Timing::usf || timing_ == Timing::usavg || timing_ == Timing::usavg_plus;
+  if (stress_first) {
+    // USF / USAVG: update stresses from v = m^-1 p (m~_k^-1 p under FMPM) before the forces.
+    particles_to_grid(true, false);
+    lap(1);
+    stress_velocity_from_momentum(nodes_.momentum, fmpm_velocities);
+    lap(3);
+    update_stresses(nodes_.velocity_work, timing_ == Timing::usf ? dt : 0.5 * dt);
+    lap(5);
+    particles_to_grid(false, true);
+  } else {
+    particles_to_grid(true, true);
+  }
+  lap(1);
   update_grid(dt);
+  lap(2);
+  if (use_full_mass_) {
+    // seed 000 Task 3: v+ = m~_k^-1 p+ (FMPM) or v = m~_k^-1 p (XPIC, blends).
+    full_mass_velocity(need == FullMass::of_updated ? nodes_.velocity_new : nodes_.velocity,
+                       nodes_.velocity_full, k);
+  }
+  lap(3);
   update_particles(dt);
-  update_stresses(dt);
+  lap(4);
+  switch (timing_) {
+    case Timing::usf:
+      break;
+    case Timing::usl:
+    case Timing::usavg:
+      update_stresses(fmpm_velocities ? nodes_.velocity_full : nodes_.velocity_new,
+                      timing_ == Timing::usl ? dt : 0.5 * dt);
+      break;
+    case Timing::usl_plus:
+    case Timing::usavg_plus:
+      // Re-extrapolate the updated particle momenta before the last stress update.
+      reextrapolate_momentum();
+      lap(1);
+      stress_velocity_from_momentum(grid_term_, fmpm_velocities);
+      lap(3);
+      update_stresses(nodes_.velocity_work, timing_ == Timing::usl_plus ? dt : 0.5 * dt);
+      break;
+  }
+  lap(5);
   time_ += dt;
   ++step_;
 }
@@ -135,43 +221,72 @@ void Simulation<D>::compute_body_forces() {
   }
 }
 
+namespace {
+/// Node position relative to the particle, taking the periodic wrap into account.
 template <int D>
-void Simulation<D>::particles_to_grid() {
+Vec<D> node_offset(const Grid<D>& grid, std::int32_t node, const Vec<D>& x) {
+  Vec<D> d = grid.node_position(node) - x;
+  for (int a = 0; a < D; ++a) {
+    if (!grid.periodic(a)) continue;
+    const double L = grid.n_cells()[a] * grid.cell_size()[a];
+    d[a] -= L * std::round(d[a] / L);
+  }
+  return d;
+}
+}  // namespace
+
+template <int D>
+void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
+  const bool has_body_force = !body_force_.empty();
+  const bool affine = scheme_->affine();
   for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
-    nodes_.mass[i] = 0.0;
-    nodes_.momentum[i].setZero();
-    nodes_.force[i].setZero();
+    if (mass_and_momentum) {
+      nodes_.mass[i] = 0.0;
+      nodes_.momentum[i].setZero();
+    }
+    if (forces) {
+      nodes_.force[i].setZero();
+      if (has_body_force) node_body_force_[i].setZero();
+    }
     nodes_.reaction[i].setZero();
   });
-  compute_body_forces();
-  const bool has_body_force = !body_force_.empty();
-  if (has_body_force) std::fill(node_body_force_.begin(), node_body_force_.end(), Vec<D>::Zero());
+  if (forces) compute_body_forces();
   const auto& P = particles_;
-  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M B (seed 000 Table 1).
+  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
   scatter(cache_, [&](std::int32_t p, std::size_t s) {
     const std::int32_t i = cache_.node[s];
     const double Sm = cache_.weight[s] * P.mass[p];
-    nodes_.mass[i] += Sm;
-    nodes_.momentum[i] += Sm * P.velocity[p];
-    const Vec<D> internal =
-        -P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * cache_.gradient[s]);
-    nodes_.force[i] += internal;
-    if (has_body_force) {
-      const Vec<D> fb = Sm * body_acceleration_[p];
-      nodes_.force[i] += fb;
-      node_body_force_[i] += fb;
+    if (mass_and_momentum) {
+      nodes_.mass[i] += Sm;
+      if (affine) {
+        const Vec<D> dx = node_offset(grid_, i, P.position[p]);
+        nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+      } else {
+        nodes_.momentum[i] += Sm * P.velocity[p];
+      }
+    }
+    if (forces) {
+      nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * cache_.gradient[s]);
+      if (has_body_force) {
+        const Vec<D> fb = Sm * body_acceleration_[p];
+        nodes_.force[i] += fb;
+        node_body_force_[i] += fb;
+      }
     }
   });
 }
 
 template <int D>
 void Simulation<D>::update_grid(double dt) {
-  // Task 3 with the lumped mass: v = m^-1 p, p+ = p + f dt, v+ = m^-1 p+.
+  // Task 3 with the lumped mass: v = m^-1 p, p+ = p + f dt, v+ = m^-1 p+. The staggered central
+  // difference start uses half the first acceleration (seed 001 Sec. 4.7, seed 003 Eq. 11-15).
+  const double f_scale =
+      (config_.method.time_integration == "central_difference" && step_ == 0) ? 0.5 : 1.0;
   for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (m > small_mass_) {
       nodes_.velocity[i] = nodes_.momentum[i] / m;
-      nodes_.velocity_new[i] = (nodes_.momentum[i] + nodes_.force[i] * dt) / m;
+      nodes_.velocity_new[i] = (nodes_.momentum[i] + f_scale * nodes_.force[i] * dt) / m;
     } else {
       nodes_.velocity[i].setZero();
       nodes_.velocity_new[i].setZero();
@@ -192,9 +307,116 @@ void Simulation<D>::update_grid(double dt) {
 }
 
 template <int D>
+void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
+  // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
+  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+    Vec<D> u = Vec<D>::Zero();
+    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[cache_.node[s]];
+    particle_vec_[p] = u;
+  });
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { out[i].setZero(); });
+  scatter(cache_, [&](std::int32_t p, std::size_t s) {
+    out[cache_.node[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
+  });
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+    const double m = nodes_.mass[i];
+    out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
+  });
+}
+
+template <int D>
+void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, int k) {
+  // seed 000 Eq. 1 in its first form: m~_k^-1 = (I + A + ... + A^(k-1)) m^-1 with A = I - S+S.
+  // Summing powers of the small operator A is the same polynomial as the alternating binomial
+  // sum, without its cancellation for large k. (The recursion printed after Eq. 1 must start
+  // from v*_1 = k m^-1 p for its terms to be binom(k, l) (S+S)^(l-1) m^-1 p.)
+  // Velocity conditions (seed 000 Sec. 2.4, Eq. 3): `lumped` and `combined` start from the
+  // corrected lumped velocity `in`; `velocity` from the uncorrected one; `velocity` and
+  // `combined` impose the conditions again on the result.
+  const std::string& method = config_.method.velocity_bc_method;
+  // The uncorrected start is rebuilt from the step's p (and f) when `in` is one of the step's
+  // own grid velocities; stress-update velocities (USF, USL+) start from their corrected value.
+  const bool from_p = &in == &nodes_.velocity, from_p_new = &in == &nodes_.velocity_new;
+  const bool uncorrected_start = method == "velocity" && !conditions_.empty() && (from_p || from_p_new);
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+    const double m = nodes_.mass[i];
+    if (!uncorrected_start) grid_term_[i] = in[i];
+    else if (m <= small_mass_) grid_term_[i].setZero();
+    else grid_term_[i] = (nodes_.momentum[i] + (from_p_new ? Vec<D>(nodes_.force[i] * step_dt_) : Vec<D>::Zero())) / m;
+  });
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
+  for (int j = 1; j < k; ++j) {
+    lumped_projection(grid_term_, grid_proj_);
+    for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+      grid_term_[i] -= grid_proj_[i];  // A^j in
+      out[i] += grid_term_[i];
+    });
+  }
+  if (method != "lumped") conditions_.apply(out, nodes_.mass, nullptr, 1.0);
+}
+
+template <int D>
+void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass) {
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+    const double m = nodes_.mass[i];
+    nodes_.velocity_work[i] = m > small_mass_ ? Vec<D>(momentum[i] / m) : Vec<D>::Zero();
+  });
+  conditions_.apply(nodes_.velocity_work, nodes_.mass, nullptr, 1.0);
+  if (full_mass) {
+    std::vector<Vec<D>>& tmp = nodes_.velocity_full;  // free at this point of the step
+    full_mass_velocity(nodes_.velocity_work, tmp, config_.method.order);
+    nodes_.velocity_work.swap(tmp);
+  }
+}
+
+template <int D>
+void Simulation<D>::reextrapolate_momentum() {
+  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { grid_term_[i].setZero(); });
+  scatter(cache_, [&](std::int32_t p, std::size_t s) {
+    grid_term_[cache_.node[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
+  });
+}
+
+template <int D>
 void Simulation<D>::update_particles(double dt) {
-  StepState<D> state{grid_, nodes_, cache_, particles_, dt};
-  scheme_->update_particles(state);
+  // Task 4 in the unified form (seed 002 Eq. 1.7-1.12): V += A dt, X += VV dt + A dt^2 / 2.
+  const UpdateScheme<D>& scheme =
+      (scheme_->full_mass() != FullMass::none && !use_full_mass_) ? *flip_ : *scheme_;
+  const bool full = use_full_mass_;
+  const bool updated_field = scheme_->full_mass() == FullMass::of_updated;
+  const bool affine = scheme.affine();
+  const double alpha_g = config_.method.grid_damping, alpha_p = config_.method.particle_damping;
+  const auto& v = nodes_.velocity;
+  const auto& v_new = nodes_.velocity_new;
+  const auto& v_full = nodes_.velocity_full;
+  auto& P = particles_;
+  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+    GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::int32_t i = cache_.node[s];
+      const double S = cache_.weight[s];
+      g.Sv += S * v[i];
+      g.Sv_new += S * v_new[i];
+      if (full) g.Sv_full += S * v_full[i];
+    }
+    if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
+    Effective<D> e = scheme.effective(g);
+    e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
+    const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
+    const Vec<D> ag_dt = g.Sv_new - g.Sv;
+    particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    P.velocity[p] += e.A_dt;
+    P.position[p] += dX;
+    if (affine) {
+      Mat3 C = Mat3::Zero();
+      for (std::size_t s = begin; s < end; ++s)
+        C.template topLeftCorner<D, D>() += v_new[cache_.node[s]] * cache_.gradient[s].transpose();
+      P.affine_velocity[p] = C;
+    }
+  });
+  dissipated_energy_ += chunked_sum<double>(static_cast<std::int64_t>(P.n()), 0.0,
+                                            [&](std::int64_t p) { return particle_scalar_[p]; });
 }
 
 template <int D>
@@ -210,14 +432,14 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, double dt) {
 }
 
 template <int D>
-void Simulation<D>::update_stresses(double dt) {
-  // Task 5: grad V_p = sum_i v+_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
+void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, double dt) {
+  // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     Mat3 L = Mat3::Zero();
     for (std::size_t s = begin; s < end; ++s)
-      L.template topLeftCorner<D, D>() += nodes_.velocity_new[cache_.node[s]] * cache_.gradient[s].transpose();
+      L.template topLeftCorner<D, D>() += grid_velocity[cache_.node[s]] * cache_.gradient[s].transpose();
     particles_.velocity_gradient[p] = L;
     Mat3& F = particles_.deformation_gradient[p];
     F = tensor_exp(L * dt) * F;

@@ -3,6 +3,7 @@
 // 000 Table 1; the run loop with outputs lives in sim/run.hpp.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,14 +39,26 @@ class Simulation {
   // ---- one explicit step (seed 000 Table 1) -------------------------------------------------
   /// dt from the CFL rule (seed 001 Eq. 34) or the fixed step, not beyond end_time.
   [[nodiscard]] double next_dt() const;
-  /// Advance by dt: the stages below in order.
+  /// Advance by dt: the stages below in the order the stress-update timing asks for.
   void step(double dt);
 
-  void build_stencils();                 ///< shapes: S_pi, G_pi into the cache; colouring
-  void particles_to_grid();              ///< Tasks 1-2: m, p, f = -G^T V0 tau + S^T M B
-  void update_grid(double dt);           ///< Task 3: p+ = p + f dt, v = m^-1 p, v+ = m^-1 p+, BCs
-  void update_particles(double dt);      ///< Task 4: the update scheme moves the particles
-  void update_stresses(double dt);       ///< Task 5: grad V = sum v+ (x) G, dF = exp(grad V dt)
+  void build_stencils();  ///< shapes: S_pi, G_pi into the cache; colouring
+  /// Tasks 1-2: m = S^T M and p = S^T M V (plus the APIC affine term), and/or
+  /// f = -G^T V0 tau + S^T M B.
+  void particles_to_grid(bool mass_and_momentum = true, bool forces = true);
+  void update_grid(double dt);      ///< Task 3: p+ = p + f dt, v = m^-1 p, v+ = m^-1 p+, conditions
+  void update_particles(double dt); ///< Task 4: the scheme's A and VV move the particles
+  /// Task 5: grad V = sum v_i (x) G_pi from `grid_velocity`, dF = exp(grad V dt), F <- dF F.
+  void update_stresses(const std::vector<Vec<D>>& grid_velocity, double dt);
+
+  /// out = m~_k^-1 m in, the k-term full mass matrix inverse (seed 000 Eq. 1) applied to
+  /// in = m^-1 q, with velocity conditions by the selected method (seed 000 Sec. 2.4).
+  void full_mass_velocity(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, int k);
+  /// out = S+ S in: grid -> particles -> grid with the lumped reverse map (seed 000 Sec. 2.1).
+  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
+
+  /// Seconds spent per pipeline stage so far (name, seconds), in pipeline order.
+  [[nodiscard]] std::vector<std::pair<std::string, double>> stage_times() const;
 
   // ---- state ----------------------------------------------------------------------------------
   [[nodiscard]] const Config& config() const { return config_; }
@@ -59,10 +72,17 @@ class Simulation {
   [[nodiscard]] long long step_count() const { return step_; }
   /// Work done on the particles by body forces and velocity conditions so far.
   [[nodiscard]] double external_work() const { return external_work_; }
-  void restore_counters(double time, long long step, double external_work) {
+  /// Energy dissipated by the particle update so far (seed 002 Eq. 1.47-1.50).
+  [[nodiscard]] double dissipated_energy() const { return dissipated_energy_; }
+  /// Time of the next full-mass step of periodic FMPM/XPIC (method.full_mass_cfl > 0).
+  [[nodiscard]] double next_full_mass_time() const { return next_full_mass_time_; }
+  void restore_counters(double time, long long step, double external_work, double dissipated,
+                        double next_full_mass_time) {
     time_ = time;
     step_ = step;
     external_work_ = external_work;
+    dissipated_energy_ = dissipated;
+    next_full_mass_time_ = next_full_mass_time;
   }
   [[nodiscard]] Totals totals() const;
 
@@ -70,6 +90,11 @@ class Simulation {
   void setup_grid();
   void compute_body_forces();
   Mat3 stress_for(std::size_t p, const Mat3& L, double dt);
+  [[nodiscard]] double max_signal_speed() const;
+  /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
+  /// with conditions, or m~_k^-1 q for FMPM.
+  void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
+  void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
 
   Config config_;
   Mode mode_;
@@ -81,6 +106,16 @@ class Simulation {
   std::vector<std::unique_ptr<Material>> materials_;
   std::unique_ptr<ShapeFamily<D>> shape_;
   std::unique_ptr<UpdateScheme<D>> scheme_;
+  std::unique_ptr<UpdateScheme<D>> flip_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
+  enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
+  bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
+  std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
+  std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles
+  std::vector<double> particle_scalar_;    ///< scratch: per-particle dissipation of the step
+  double dissipated_energy_ = 0.0;
+  double step_dt_ = 0.0;
+  double next_full_mass_time_ = 0.0;
+  std::array<double, 6> stage_seconds_{};
   std::vector<std::unique_ptr<ExpressionVector<D>>> body_force_;  ///< one per thread
   bool body_force_constant_ = false;
   Vec<D> body_force_value_ = Vec<D>::Zero();

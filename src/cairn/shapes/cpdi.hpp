@@ -1,0 +1,250 @@
+// Convected particle domain interpolation (CPDI; Sadeghirad, Brannon & Burghardt 2011), written
+// once for any grid function N (linear: cpdi, quadratic B-spline: b2cpdi; seed 000 Sec. 2.1).
+//
+// The particle domain is the parallelogram (2D) / parallelepiped (3D) / segment (1D) spanned by
+// the initial half edges convected by F: R = F diag(l_p0 / 2), corners x_c = x_p + R s_c with
+// s_c in {-1, +1}^D. Seed 000 Sec. 2.1 (bracketed forms) replaces N_i inside the domain by its
+// multilinear interpolation from the corners, sum_c M_c(x) N_i(x_c). Because the map
+// x = x_p + R xi from the reference cube [-1, 1]^D is affine, both integrals are exact in closed
+// form: (1/V_p) int M_c dx = 1 / 2^D and (1/V_p) int grad M_c dx = R^-T s_c / 2^D, so
+//     S_pi = 2^-D sum_c N_i(x_c),       G_pi = 2^-D sum_c N_i(x_c) R^-T s_c.
+// (In 2D this is the familiar CPDI gradient built from the edge vectors r1, r2: R^-T s_c / 4
+// expands to the same cross-product expressions.) Partition of unity, zero gradient sum and exact
+// reproduction of linear fields follow from sum_c s_c = 0 and sum_c s_c s_c^T = 2^D I.
+//
+// Guard for domains that get too distorted: when the domain spans more than
+// method.cpdi_max_span cells along some axis, or R is singular or inverted, the particle uses
+// the GIMP weights of its undeformed box (uGIMP for cpdi, B2GIMP for b2cpdi) for that step. This
+// bounds the stencil (and the cache stride) and avoids the numerical separation of stretched
+// domains whose corners fall in disconnected cells (seed 000 Sec. 3.4, item 4).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+#include <vector>
+
+#include "cairn/shapes/grid_functions.hpp"
+#include "cairn/shapes/shape_family.hpp"
+#include "cairn/util/failure.hpp"
+
+namespace cairn {
+
+namespace cpdi_detail {
+
+/// Geometry of one particle's stencil for this step.
+template <int D>
+struct Domain {
+  static constexpr int n_corners = 1 << D;
+  std::array<Vec<D>, n_corners> corner;    ///< corner positions in cell units
+  std::array<Vec<D>, n_corners> gradient;  ///< 2^-D R^-T s_c (physical units)
+  IVec<D> lo, dims;                        ///< node box: first node and nodes per axis
+  bool fallback = false;                   ///< GIMP of the undeformed box instead
+  Vec<D> half;                             ///< fallback: box half-width in cells
+};
+
+template <int D>
+Vec<D> corner_sign(int c) {
+  Vec<D> s;
+  for (int a = 0; a < D; ++a) s[a] = (c >> a) & 1 ? 1.0 : -1.0;
+  return s;
+}
+
+template <int D, class Fn>
+Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_t p, double max_span) {
+  Domain<D> dom;
+  const Vec<D> h = grid.cell_size();
+  const Vec<D> xi = grid.to_cell_units(parts.position[p]);
+  const Vec<D> half_size = 0.5 * parts.size0[p];
+  using MatD = Eigen::Matrix<double, D, D>;
+  const MatD F = parts.deformation_gradient[p].template topLeftCorner<D, D>();
+  const MatD R = F * half_size.asDiagonal();  // columns: convected half edges (physical)
+  const MatD Rc = h.cwiseInverse().asDiagonal() * R;
+  const double det = R.determinant();
+  bool ok = std::isfinite(det) && det > 0.0;
+  for (int a = 0; a < D && ok; ++a) ok = 2.0 * Rc.row(a).cwiseAbs().sum() <= max_span;
+  if (!ok) {
+    dom.fallback = true;
+    dom.half = half_size.cwiseQuotient(h);
+    for (int a = 0; a < D; ++a) {
+      dom.lo[a] = static_cast<int>(std::ceil(xi[a] - Fn::support - dom.half[a]));
+      dom.dims[a] = convolved_width<Fn>(dom.half[a]);
+    }
+    return dom;
+  }
+  const MatD RinvT = R.inverse().transpose() / static_cast<double>(Domain<D>::n_corners);
+  IVec<D> hi;
+  dom.lo.setConstant(INT_MAX);
+  hi.setConstant(INT_MIN);
+  for (int c = 0; c < Domain<D>::n_corners; ++c) {
+    const Vec<D> s = corner_sign<D>(c);
+    dom.corner[c] = xi + Rc * s;
+    dom.gradient[c] = RinvT * s;
+    for (int a = 0; a < D; ++a) {
+      const int f = Fn::first_node(dom.corner[c][a]);
+      dom.lo[a] = std::min(dom.lo[a], f);
+      hi[a] = std::max(hi[a], f + Fn::n_nodes - 1);
+    }
+  }
+  dom.dims = hi - dom.lo + IVec<D>::Ones();
+  return dom;
+}
+
+}  // namespace cpdi_detail
+
+/// Fill the cache with CPDI weights of grid function Fn (see the file comment).
+template <int D, class Fn>
+void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& particles,
+                TransferCache<D>& cache) {
+  using Domain = cpdi_detail::Domain<D>;
+  constexpr int n_corners = Domain::n_corners;
+  constexpr int nn = Fn::n_nodes;
+  const auto n = static_cast<std::int64_t>(particles.n());
+  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+
+  // Pass 1: the largest node box of this step sets the cache stride.
+  int slots = 1;
+#pragma omp parallel for reduction(max : slots) schedule(static)
+  for (std::int64_t p = 0; p < n; ++p)
+    slots = std::max(slots, cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims.prod());
+  cache.reserve(particles.n(), slots);
+
+  std::int64_t first_bad = INT64_MAX;
+  IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+#pragma omp parallel
+  {
+    IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
+    std::int64_t bad_t = INT64_MAX;
+    std::vector<double> S(static_cast<std::size_t>(slots));
+    std::vector<Vec<D>> G(static_cast<std::size_t>(slots));
+    std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * slots);
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
+      const Domain dom = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span);
+      const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      IVec<D> cell;
+      for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(xi[a]));
+      cache.cell[p] = cell;
+      IVec<D> stride;
+      int box = 1;
+      for (int a = 0; a < D; ++a) {
+        stride[a] = box;
+        box *= dom.dims[a];
+      }
+      std::fill(S.begin(), S.begin() + box, 0.0);
+      std::fill(G.begin(), G.begin() + box, Vec<D>::Zero());
+
+      if (dom.fallback) {
+        // GIMP of the undeformed box: tensor product of the exact 1D convolutions.
+        std::array<std::vector<double>, D> w1, dw1;
+        for (int a = 0; a < D; ++a) {
+          w1[a].resize(dom.dims[a]);
+          dw1[a].resize(dom.dims[a]);
+          convolved_weights<Fn>(xi[a], dom.half[a], dom.dims[a], w1[a].data(), dw1[a].data());
+        }
+        for (int idx = 0; idx < box; ++idx) {
+          double value = 1.0;
+          Vec<D> grad = Vec<D>::Ones();
+          int rem = idx;
+          for (int a = 0; a < D; ++a) {
+            const int k = rem % dom.dims[a];
+            rem /= dom.dims[a];
+            value *= w1[a][k];
+            for (int b = 0; b < D; ++b) grad[b] *= (a == b) ? dw1[a][k] * inv_h[a] : w1[a][k];
+          }
+          S[idx] = value;
+          G[idx] = grad;
+        }
+      } else {
+        // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c.
+        for (int c = 0; c < n_corners; ++c) {
+          std::array<std::array<double, nn>, D> v;
+          int base = 0;
+          for (int a = 0; a < D; ++a) {
+            const double x = dom.corner[c][a];
+            const int f = Fn::first_node(x);
+            for (int k = 0; k < nn; ++k) v[a][k] = Fn::value(x - (f + k));
+            base += (f - dom.lo[a]) * stride[a];
+          }
+          const Vec<D>& g = dom.gradient[c];
+          if constexpr (D == 1) {
+            for (int i = 0; i < nn; ++i) {
+              S[base + i] += v[0][i];
+              G[base + i] += v[0][i] * g;
+            }
+          } else if constexpr (D == 2) {
+            for (int j = 0; j < nn; ++j)
+              for (int i = 0; i < nn; ++i) {
+                const double N = v[0][i] * v[1][j];
+                const int idx = base + i + j * stride[1];
+                S[idx] += N;
+                G[idx] += N * g;
+              }
+          } else {
+            for (int k = 0; k < nn; ++k)
+              for (int j = 0; j < nn; ++j) {
+                const double vjk = v[1][j] * v[2][k];
+                const int row = base + j * stride[1] + k * stride[2];
+                for (int i = 0; i < nn; ++i) {
+                  const double N = v[0][i] * vjk;
+                  S[row + i] += N;
+                  G[row + i] += N * g;
+                }
+              }
+          }
+        }
+        const double inv_corners = 1.0 / n_corners;
+        for (int idx = 0; idx < box; ++idx) S[idx] *= inv_corners;
+      }
+
+      // Compact the non-zero entries into the cache.
+      for (int a = 0; a < D; ++a)
+        for (int k = 0; k < dom.dims[a]; ++k) offset[a * slots + k] = grid.axis_index(a, dom.lo[a] + k);
+      const std::size_t out = static_cast<std::size_t>(p) * cache.stride;
+      int used = 0;
+      for (int idx = 0; idx < box; ++idx) {
+        if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
+        std::int32_t node = 0;
+        bool outside = false;
+        int rem = idx;
+        for (int a = 0; a < D; ++a) {
+          const int k = rem % dom.dims[a];
+          rem /= dom.dims[a];
+          const int j = dom.lo[a] + k;
+          lo_t[a] = std::max(lo_t[a], cell[a] - j);
+          hi_t[a] = std::max(hi_t[a], j - cell[a] - 1);
+          outside |= offset[a * slots + k] < 0;
+          node += offset[a * slots + k];
+        }
+        if (outside) {
+          bad_t = std::min<std::int64_t>(bad_t, p);
+          continue;
+        }
+        cache.node[out + used] = node;
+        cache.weight[out + used] = S[idx];
+        cache.gradient[out + used] = G[idx];
+        ++used;
+      }
+      cache.count[p] = static_cast<std::uint16_t>(used);
+    }
+#pragma omp critical
+    {
+      first_bad = std::min(first_bad, bad_t);
+      lo = lo.cwiseMax(lo_t);
+      hi = hi.cwiseMax(hi_t);
+    }
+  }
+  cache.reach_lo = lo;
+  cache.reach_hi = hi;
+  if (first_bad != INT64_MAX) {
+    const Vec<D>& x = particles.position[first_bad];
+    std::string where;
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    throw SimulationFailure(first_bad, "position",
+                            "particle " + std::to_string(first_bad) + " left the grid at (" +
+                                where + "): its CPDI domain reaches beyond the ghost nodes");
+  }
+}
+
+}  // namespace cairn
