@@ -48,3 +48,17 @@ TEST(TensorExp, AgreesWithEigensPadeForLargeArguments) {
 
 }  // namespace
 }  // namespace cairn
+
+namespace cairn {
+namespace {
+
+TEST(TensorExp, NonFiniteArgumentGivesNaNInsteadOfLooping) {
+  Mat3 a = Mat3::Zero();
+  a(0, 0) = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(tensor_exp(a).allFinite());
+  a(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(tensor_exp(a).allFinite());
+}
+
+}  // namespace
+}  // namespace cairn

@@ -1,6 +1,7 @@
 #include "cairn/math/tensor.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace cairn {
 
@@ -11,6 +12,7 @@ namespace cairn {
 // times cheaper than a general Pade evaluation with its 3x3 solve, and exact to round-off.
 Mat3 tensor_exp(const Mat3& a) {
   const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
+  if (!std::isfinite(norm)) return Mat3::Constant(std::numeric_limits<double>::quiet_NaN());
   int s = 0;
   if (norm > 0.5) s = static_cast<int>(std::ceil(std::log2(norm / 0.5)));
   const Mat3 scaled = (s > 0) ? Mat3(a / std::ldexp(1.0, s)) : a;

@@ -37,57 +37,41 @@ namespace cpdi_detail {
 template <int D>
 struct Domain {
   static constexpr int n_corners = 1 << D;
-  std::array<Vec<D>, n_corners> corner;    ///< corner positions in cell units
-  std::array<Vec<D>, n_corners> gradient;  ///< 2^-D R^-T s_c (physical units)
+  Vec<D> xi;                               ///< particle position in cell units
+  Eigen::Matrix<double, D, D> Rc;          ///< half edges in cell units (columns)
+  Vec<D> extent;                           ///< half of the corner spread per axis (cells)
   IVec<D> lo, dims;                        ///< node box: first node and nodes per axis
   bool fallback = false;                   ///< GIMP of the undeformed box instead
   Vec<D> half;                             ///< fallback: box half-width in cells
 };
 
-template <int D>
-Vec<D> corner_sign(int c) {
-  Vec<D> s;
-  for (int a = 0; a < D; ++a) s[a] = (c >> a) & 1 ? 1.0 : -1.0;
-  return s;
-}
-
+/// Corner spread, guard decision and node box; cheap enough to run twice per step.
 template <int D, class Fn>
 Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_t p, double max_span) {
   Domain<D> dom;
-  const Vec<D> h = grid.cell_size();
-  const Vec<D> xi = grid.to_cell_units(parts.position[p]);
+  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+  dom.xi = grid.to_cell_units(parts.position[p]);
   const Vec<D> half_size = 0.5 * parts.size0[p];
-  using MatD = Eigen::Matrix<double, D, D>;
-  const MatD F = parts.deformation_gradient[p].template topLeftCorner<D, D>();
-  const MatD R = F * half_size.asDiagonal();  // columns: convected half edges (physical)
-  const MatD Rc = h.cwiseInverse().asDiagonal() * R;
-  const double det = R.determinant();
+  const auto F = parts.deformation_gradient[p].template topLeftCorner<D, D>();
+  dom.Rc = inv_h.asDiagonal() * F * half_size.asDiagonal();
+  dom.extent = dom.Rc.cwiseAbs().rowwise().sum();
+  const double det = F.determinant();
   bool ok = std::isfinite(det) && det > 0.0;
-  for (int a = 0; a < D && ok; ++a) ok = 2.0 * Rc.row(a).cwiseAbs().sum() <= max_span;
+  for (int a = 0; a < D && ok; ++a) ok = 2.0 * dom.extent[a] <= max_span;
   if (!ok) {
     dom.fallback = true;
-    dom.half = half_size.cwiseQuotient(h);
+    dom.half = half_size.cwiseProduct(inv_h);
     for (int a = 0; a < D; ++a) {
-      dom.lo[a] = static_cast<int>(std::ceil(xi[a] - Fn::support - dom.half[a]));
+      dom.lo[a] = static_cast<int>(std::ceil(dom.xi[a] - Fn::support - dom.half[a]));
       dom.dims[a] = convolved_width<Fn>(dom.half[a]);
     }
     return dom;
   }
-  const MatD RinvT = R.inverse().transpose() / static_cast<double>(Domain<D>::n_corners);
-  IVec<D> hi;
-  dom.lo.setConstant(INT_MAX);
-  hi.setConstant(INT_MIN);
-  for (int c = 0; c < Domain<D>::n_corners; ++c) {
-    const Vec<D> s = corner_sign<D>(c);
-    dom.corner[c] = xi + Rc * s;
-    dom.gradient[c] = RinvT * s;
-    for (int a = 0; a < D; ++a) {
-      const int f = Fn::first_node(dom.corner[c][a]);
-      dom.lo[a] = std::min(dom.lo[a], f);
-      hi[a] = std::max(hi[a], f + Fn::n_nodes - 1);
-    }
+  // first_node is monotone, so the extreme corners bound the box.
+  for (int a = 0; a < D; ++a) {
+    dom.lo[a] = Fn::first_node(dom.xi[a] - dom.extent[a]);
+    dom.dims[a] = Fn::first_node(dom.xi[a] + dom.extent[a]) + Fn::n_nodes - dom.lo[a];
   }
-  dom.dims = hi - dom.lo + IVec<D>::Ones();
   return dom;
 }
 
@@ -98,16 +82,21 @@ template <int D, class Fn>
 void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& particles,
                 TransferCache<D>& cache) {
   using Domain = cpdi_detail::Domain<D>;
+  using MatD = Eigen::Matrix<double, D, D>;
   constexpr int n_corners = Domain::n_corners;
   constexpr int nn = Fn::n_nodes;
   const auto n = static_cast<std::int64_t>(particles.n());
-  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+  const Vec<D> h = grid.cell_size();
+  const Vec<D> inv_h = h.cwiseInverse();
 
   // Pass 1: the largest node box of this step sets the cache stride.
-  int slots = 1;
-#pragma omp parallel for reduction(max : slots) schedule(static)
-  for (std::int64_t p = 0; p < n; ++p)
-    slots = std::max(slots, cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims.prod());
+  int slots = 1, widest = 1;
+#pragma omp parallel for reduction(max : slots, widest) schedule(static)
+  for (std::int64_t p = 0; p < n; ++p) {
+    const IVec<D> dims = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims;
+    slots = std::max(slots, dims.prod());
+    widest = std::max(widest, dims.maxCoeff());
+  }
   cache.reserve(particles.n(), slots);
 
   std::int64_t first_bad = INT64_MAX;
@@ -116,15 +105,17 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
-    std::vector<double> S(static_cast<std::size_t>(slots));
-    std::vector<Vec<D>> G(static_cast<std::size_t>(slots));
-    std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * slots);
+    std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * widest);
+    std::array<std::vector<double>, D> w1, dw1;  // fallback weights per axis
+    for (int a = 0; a < D; ++a) {
+      w1[a].resize(widest);
+      dw1[a].resize(widest);
+    }
 #pragma omp for schedule(static)
     for (std::int64_t p = 0; p < n; ++p) {
       const Domain dom = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span);
-      const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       IVec<D> cell;
-      for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(xi[a]));
+      for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(dom.xi[a]));
       cache.cell[p] = cell;
       IVec<D> stride;
       int box = 1;
@@ -132,17 +123,18 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
         stride[a] = box;
         box *= dom.dims[a];
       }
-      std::fill(S.begin(), S.begin() + box, 0.0);
-      std::fill(G.begin(), G.begin() + box, Vec<D>::Zero());
+      // Accumulate straight into the particle's cache slots (box order, box <= stride), then
+      // compact them in place.
+      const std::size_t out = static_cast<std::size_t>(p) * cache.stride;
+      double* S = &cache.weight[out];
+      Vec<D>* G = &cache.gradient[out];
+      std::fill(S, S + box, 0.0);
+      std::fill(G, G + box, Vec<D>::Zero());
 
       if (dom.fallback) {
         // GIMP of the undeformed box: tensor product of the exact 1D convolutions.
-        std::array<std::vector<double>, D> w1, dw1;
-        for (int a = 0; a < D; ++a) {
-          w1[a].resize(dom.dims[a]);
-          dw1[a].resize(dom.dims[a]);
-          convolved_weights<Fn>(xi[a], dom.half[a], dom.dims[a], w1[a].data(), dw1[a].data());
-        }
+        for (int a = 0; a < D; ++a)
+          convolved_weights<Fn>(dom.xi[a], dom.half[a], dom.dims[a], w1[a].data(), dw1[a].data());
         for (int idx = 0; idx < box; ++idx) {
           double value = 1.0;
           Vec<D> grad = Vec<D>::Ones();
@@ -157,30 +149,32 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
           G[idx] = grad;
         }
       } else {
-        // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c.
+        // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c, where
+        // R = diag(h) Rc is the physical half-edge matrix.
+        const MatD RinvT =
+            (h.asDiagonal() * dom.Rc).inverse().transpose() / static_cast<double>(n_corners);
         for (int c = 0; c < n_corners; ++c) {
+          Vec<D> sgn;
+          for (int a = 0; a < D; ++a) sgn[a] = (c >> a) & 1 ? 1.0 : -1.0;
+          const Vec<D> corner = dom.xi + dom.Rc * sgn;
+          const Vec<D> g = RinvT * sgn;
           std::array<std::array<double, nn>, D> v;
           int base = 0;
-          for (int a = 0; a < D; ++a) {
-            const double x = dom.corner[c][a];
-            const int f = Fn::first_node(x);
-            for (int k = 0; k < nn; ++k) v[a][k] = Fn::value(x - (f + k));
-            base += (f - dom.lo[a]) * stride[a];
-          }
-          const Vec<D>& g = dom.gradient[c];
+          for (int a = 0; a < D; ++a) base += (Fn::weights(corner[a], v[a].data()) - dom.lo[a]) * stride[a];
           if constexpr (D == 1) {
             for (int i = 0; i < nn; ++i) {
               S[base + i] += v[0][i];
               G[base + i] += v[0][i] * g;
             }
           } else if constexpr (D == 2) {
-            for (int j = 0; j < nn; ++j)
+            for (int j = 0; j < nn; ++j) {
+              const int row = base + j * stride[1];
               for (int i = 0; i < nn; ++i) {
                 const double N = v[0][i] * v[1][j];
-                const int idx = base + i + j * stride[1];
-                S[idx] += N;
-                G[idx] += N * g;
+                S[row + i] += N;
+                G[row + i] += N * g;
               }
+            }
           } else {
             for (int k = 0; k < nn; ++k)
               for (int j = 0; j < nn; ++j) {
@@ -198,33 +192,42 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
         for (int idx = 0; idx < box; ++idx) S[idx] *= inv_corners;
       }
 
-      // Compact the non-zero entries into the cache.
-      for (int a = 0; a < D; ++a)
-        for (int k = 0; k < dom.dims[a]; ++k) offset[a * slots + k] = grid.axis_index(a, dom.lo[a] + k);
-      const std::size_t out = static_cast<std::size_t>(p) * cache.stride;
+      // Compact the non-zero entries into the cache: rows along axis 0, the other axes by an
+      // odometer. The box bounds give the colouring reach.
+      for (int a = 0; a < D; ++a) {
+        for (int k = 0; k < dom.dims[a]; ++k) offset[a * widest + k] = grid.axis_index(a, dom.lo[a] + k);
+        lo_t[a] = std::max(lo_t[a], cell[a] - dom.lo[a]);
+        hi_t[a] = std::max(hi_t[a], dom.lo[a] + dom.dims[a] - 1 - cell[a] - 1);
+      }
       int used = 0;
-      for (int idx = 0; idx < box; ++idx) {
-        if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
-        std::int32_t node = 0;
-        bool outside = false;
-        int rem = idx;
-        for (int a = 0; a < D; ++a) {
-          const int k = rem % dom.dims[a];
-          rem /= dom.dims[a];
-          const int j = dom.lo[a] + k;
-          lo_t[a] = std::max(lo_t[a], cell[a] - j);
-          hi_t[a] = std::max(hi_t[a], j - cell[a] - 1);
-          outside |= offset[a * slots + k] < 0;
-          node += offset[a * slots + k];
+      const int n_rows = box / dom.dims[0];
+      IVec<D> k = IVec<D>::Zero();
+      for (int row = 0; row < n_rows; ++row) {
+        std::int32_t row_node = 0;
+        bool row_outside = false;
+        for (int a = 1; a < D; ++a) {
+          const std::int32_t off = offset[a * widest + k[a]];
+          row_outside |= off < 0;
+          row_node += off;
         }
-        if (outside) {
-          bad_t = std::min<std::int64_t>(bad_t, p);
-          continue;
+        const int first = row * dom.dims[0];
+        for (int i = 0; i < dom.dims[0]; ++i) {
+          const int idx = first + i;
+          if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
+          const std::int32_t off = offset[i];
+          if (row_outside || off < 0) {
+            bad_t = std::min<std::int64_t>(bad_t, p);
+            continue;
+          }
+          cache.node[out + used] = row_node + off;
+          S[used] = S[idx];  // used <= idx: in-place compaction
+          G[used] = G[idx];
+          ++used;
         }
-        cache.node[out + used] = node;
-        cache.weight[out + used] = S[idx];
-        cache.gradient[out + used] = G[idx];
-        ++used;
+        for (int a = 1; a < D; ++a) {
+          if (++k[a] < dom.dims[a]) break;
+          k[a] = 0;
+        }
       }
       cache.count[p] = static_cast<std::uint16_t>(used);
     }

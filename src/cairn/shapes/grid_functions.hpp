@@ -62,6 +62,13 @@ struct LinearGridFunction {
   /// First node with a possibly non-zero N at xi, and the number of such nodes (2).
   static int first_node(double xi) { return static_cast<int>(std::floor(xi)); }
   static constexpr int n_nodes = 2;
+  /// Values at the n_nodes nodes from first_node(xi); returns first_node(xi).
+  static int weights(double xi, double* w) {
+    const double f = std::floor(xi);
+    w[1] = xi - f;
+    w[0] = 1.0 - w[1];
+    return static_cast<int>(f);
+  }
 };
 
 /// The quadratic B-spline grid function (B2GIMP, B2CPDI of seed 000 Sec. 2.1).
@@ -72,6 +79,14 @@ struct QuadraticGridFunction {
   static double integral(double s) { return quadratic_spline_integral(s); }
   static int first_node(double xi) { return static_cast<int>(std::floor(xi + 0.5)) - 1; }
   static constexpr int n_nodes = 3;
+  static int weights(double xi, double* w) {
+    const double c = std::floor(xi + 0.5);
+    const double d = xi - c;
+    w[0] = 0.5 * (0.5 - d) * (0.5 - d);
+    w[1] = 0.75 - d * d;
+    w[2] = 0.5 * (0.5 + d) * (0.5 + d);
+    return static_cast<int>(c) - 1;
+  }
 };
 
 /// Most nodes per axis a box of half-width a (cells) convolved with grid function Fn can touch.

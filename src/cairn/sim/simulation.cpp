@@ -406,13 +406,21 @@ void Simulation<D>::update_particles(double dt) {
     // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
     particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    const Vec<D> x_old = P.position[p];
     P.velocity[p] += e.A_dt;
     P.position[p] += dX;
     if (affine) {
-      Mat3 C = Mat3::Zero();
-      for (std::size_t s = begin; s < end; ++s)
-        C.template topLeftCorner<D, D>() += v_new[cache_.node[s]] * cache_.gradient[s].transpose();
-      P.affine_velocity[p] = C;
+      // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
+      // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
+      // for every shape family (D = h^2/4 I for quadratic splines).
+      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+      for (std::size_t s = begin; s < end; ++s) {
+        const Vec<D> d = node_offset(grid_, cache_.node[s], x_old);
+        B += cache_.weight[s] * v_new[cache_.node[s]] * d.transpose();
+        Dp += cache_.weight[s] * d * d.transpose();
+      }
+      P.affine_velocity[p].setZero();
+      P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
     }
   });
   dissipated_energy_ += chunked_sum<double>(static_cast<std::int64_t>(P.n()), 0.0,
