@@ -47,6 +47,15 @@ void print_summary(const cairn::RunSummary& s) {
              s.n_particles);
   fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
+  double total = 0.0;
+  for (const auto& [name, sec] : s.stage_seconds) total += sec;
+  if (total > 0.0) {
+    std::string line = "cairn: time per stage:";
+    for (const auto& [name, sec] : s.stage_seconds)
+      if (sec > 0.0) line += fmt::format(" {} {:.3f} s ({:.0f}%),", name, sec, 100.0 * sec / total);
+    line.pop_back();
+    fmt::print("{}\n", line);
+  }
 }
 
 }  // namespace

@@ -119,6 +119,7 @@ class Runner {
         summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
+    summary.stage_seconds = sim_.stage_times();
     return summary;
   }
 

@@ -22,6 +22,8 @@ struct RunSummary {
   std::size_t n_particles = 0;
   std::filesystem::path output_directory;
   std::filesystem::path last_checkpoint;
+  /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).
+  std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
 /// A run stopped by a SimulationFailure, with the step and time at which it happened. The last
