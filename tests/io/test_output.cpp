@@ -98,6 +98,8 @@ Particles<D> random_particles(std::size_t n, int n_state, std::mt19937_64& rng) 
     ps.deformation_gradient[p] = mat();
     ps.kirchhoff_stress[p] = mat() * 1e9;
     ps.velocity_gradient[p] = mat();
+    ps.affine_velocity[p] = mat();
+    ps.temperature[p] = 300.0 + u(rng);
     ps.material[p] = k(rng);
     ps.body[p] = k(rng);
   }
@@ -139,6 +141,8 @@ void expect_particles_identical(const Particles<D>& a, const Particles<D>& b) {
   expect_mats_identical(a.deformation_gradient, b.deformation_gradient, "F");
   expect_mats_identical(a.kirchhoff_stress, b.kirchhoff_stress, "tau");
   expect_mats_identical(a.velocity_gradient, b.velocity_gradient, "grad v");
+  expect_mats_identical(a.affine_velocity, b.affine_velocity, "C");
+  EXPECT_TRUE(same_bits(a.temperature, b.temperature));
   EXPECT_EQ(a.material, b.material);
   EXPECT_EQ(a.body, b.body);
   EXPECT_TRUE(a.state == b.state);

@@ -3,6 +3,7 @@
 Each case script imports this module (it adds verification/common to sys.path), then:
   args = cairn_case.parse_args("bar_1d_mms", __doc__)   # --quick, --cairn, --out, --threads
   cairn_case.run_cairn(args, toml_path, out_dir)         # writes the input, runs `cairn run ... -q`
+  cairn_case.stage_times(log)                            # seconds per stage of a run without -q
   cairn_case.read_history(dir), cairn_case.snapshots(dir), cairn_case.read_snapshot(file)
   cairn_case.print_table(...), cairn_case.save_plot(fig, args), cairn_case.finish(checks)
 
@@ -82,15 +83,17 @@ def toml_text(doc: dict, header: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_cairn(args, toml_path: Path, run_dir: Path) -> float:
+def run_cairn(args, toml_path: Path, run_dir: Path, quiet: bool = True) -> float:
     """Run `cairn run toml_path -q` writing into run_dir; returns the wall time in seconds.
 
     The input file itself must name run_dir as output.directory (so that it reproduces the run);
     the thread count comes from --threads. Raises RuntimeError with cairn's output on failure.
+    quiet=False drops -q, so that the log (<toml stem>.log next to run_dir) ends with cairn's run
+    summary, including the time per stage (see stage_times).
     """
     if run_dir.exists():
         shutil.rmtree(run_dir)
-    cmd = [args.cairn, "run", str(toml_path), "-q"]
+    cmd = [args.cairn, "run", str(toml_path)] + (["-q"] if quiet else [])
     if args.threads > 0:
         cmd += ["--set", f"simulation.threads={args.threads}"]
     t0 = time.monotonic()
@@ -102,6 +105,16 @@ def run_cairn(args, toml_path: Path, run_dir: Path) -> float:
         raise RuntimeError(f"cairn failed (exit {proc.returncode}) on {toml_path}:\n"
                            + proc.stdout[-2000:] + proc.stderr[-2000:])
     return wall
+
+
+def stage_times(log_path: Path) -> dict[str, float]:
+    """Seconds per step stage from the `cairn: time per stage:` line of a non-quiet run's log."""
+    out = {}
+    for line in Path(log_path).read_text().splitlines():
+        if line.startswith("cairn: time per stage:"):
+            for name, sec in re.findall(r"(\w+) ([0-9.eE+-]+) s \(", line):
+                out[name] = float(sec)
+    return out
 
 
 def read_history(run_dir: Path) -> dict[str, np.ndarray]:

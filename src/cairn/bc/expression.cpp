@@ -6,6 +6,22 @@
 
 namespace cairn {
 
+namespace {
+/// Triangular pulse of full width w, peak 1 at t = w / 2, zero outside 0 < t < w (seed 000
+/// Sec. 3.3, tri(t, dt)).
+double tri(double t, double w) {
+  if (!(w > 0.0) || t <= 0.0 || t >= w) return 0.0;
+  const double s = t / w;
+  return s <= 0.5 ? 2.0 * s : 2.0 * (1.0 - s);
+}
+/// Linear ramp from 0 at t = 0 to 1 at t = r, constant afterwards.
+double ramp(double t, double r) {
+  if (t <= 0.0) return 0.0;
+  if (!(r > 0.0) || t >= r) return 1.0;
+  return t / r;
+}
+}  // namespace
+
 Expression::Expression(const std::string& text, const Constants& constants)
     : text_(text), parser_(std::make_unique<mu::Parser>()) {
   try {
@@ -17,11 +33,14 @@ Expression::Expression(const std::string& text, const Constants& constants)
     parser_->DefineVar("Z", &Z_);
     parser_->DefineVar("t", &t_);
     parser_->DefineConst("pi", 3.141592653589793238462643383279502884);
+    parser_->DefineFun("tri", tri);
+    parser_->DefineFun("ramp", ramp);
     for (const auto& [name, value] : constants) parser_->DefineConst(name, value);
     parser_->SetExpr(text);
     const auto used = parser_->GetUsedVar();  // also checks the syntax
     constant_ = used.empty();
     uses_x_ = used.count("x") || used.count("y") || used.count("z");
+    uses_position_ = uses_x_ || used.count("X") || used.count("Y") || used.count("Z");
     parser_->Eval();
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument("expression \"" + text + "\": " + e.GetMsg());

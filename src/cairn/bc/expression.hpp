@@ -1,6 +1,10 @@
 // Expressions in the input (initial velocities, displacements, body forces) evaluated with
 // muParser. Variables: x, y, z (current position), X, Y, Z (reference position), t (time); the
 // [constants] of the input and muParser's _pi and _e are available, and `pi` as an alias.
+// Time functions for loads and velocity conditions (docs/boundary-conditions.md):
+//   tri(t, w)   triangular pulse of full width w: 0 outside 0 < t < w, peak 1 at t = w/2
+//               (seed 000 Sec. 3.3);
+//   ramp(t, r)  linear rise from 0 at t = 0 to 1 at t = r, 1 afterwards (0 before t = 0).
 //
 // One Expression is not safe to evaluate from two threads at once (muParser keeps its variables
 // in the parser object); ExpressionVector::for_threads() makes one copy per thread.
@@ -33,6 +37,8 @@ class Expression {
   /// True when the expression uses no variable (its value can be computed once).
   [[nodiscard]] bool is_constant() const { return constant_; }
   [[nodiscard]] bool uses_current_position() const { return uses_x_; }
+  /// True when the expression uses a position variable (x, y, z, X, Y or Z).
+  [[nodiscard]] bool uses_position() const { return uses_position_; }
   [[nodiscard]] const std::string& text() const { return text_; }
 
  private:
@@ -41,6 +47,7 @@ class Expression {
   double x_ = 0, y_ = 0, z_ = 0, X_ = 0, Y_ = 0, Z_ = 0, t_ = 0;
   bool constant_ = false;
   bool uses_x_ = false;
+  bool uses_position_ = false;
 };
 
 /// D expressions forming a vector field.

@@ -57,6 +57,7 @@ void check_particles(const Particles<D>& ps) {
                   ps.mass.size() == n && ps.volume0.size() == n && ps.size0.size() == n &&
                   ps.deformation_gradient.size() == n && ps.kirchhoff_stress.size() == n &&
                   ps.velocity_gradient.size() == n && ps.affine_velocity.size() == n &&
+                  ps.temperature.size() == n &&
                   ps.material.size() == n &&
                   ps.body.size() == n && ps.n_state_per_particle >= 0 &&
                   ps.state.size() == n * static_cast<std::size_t>(ps.n_state_per_particle);
@@ -169,6 +170,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
       write_vecs<D>(gid, "velocity", ps.velocity);
       h5::write_doubles(gid, "mass", ps.mass.data(), n);
       h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
+      h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
       write_vecs<D>(gid, "size0", ps.size0);
       write_mats(gid, "deformation_gradient", ps.deformation_gradient);
       write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
@@ -240,6 +242,7 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
     ps.velocity = read_vecs<D>(gid, "velocity", n);
     ps.mass = h5::read_doubles(gid, "mass", {n});
     ps.volume0 = h5::read_doubles(gid, "volume0", {n});
+    ps.temperature = h5::read_doubles(gid, "temperature", {n});
     ps.size0 = read_vecs<D>(gid, "size0", n);
     ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
     ps.kirchhoff_stress = read_mats(gid, "kirchhoff_stress", n);

@@ -103,6 +103,51 @@ struct BodyForceConfig {
   std::vector<std::string> expression;  ///< D expressions in x,y,z,X,Y,Z,t; empty = no body force
 };
 
+/// Piecewise-linear factor of time: (t, value) points with increasing t, constant beyond the
+/// ends; empty means 1 (docs/boundary-conditions.md).
+using TimeTable = std::vector<std::pair<double, double>>;
+
+/// [[traction]]: a traction on the exposed faces of particles (seed 000 Sec. 2.4, first equation).
+struct TractionConfig {
+  std::string name;
+  std::string body;                      ///< "" = every body
+  int side = -1;                         ///< face 2*axis + (0 min, 1 max); -1 = any exposed face
+  std::vector<double> box_min, box_max;  ///< D values each, or empty (no box)
+  std::vector<double> traction;          ///< D values: force per current face area
+  std::string scale = "1";               ///< time factor: expression in t
+  TimeTable table;                       ///< further time factor; empty = 1
+  SourceLocation where;
+};
+
+/// [[velocity]]: a grid velocity condition on a node set (seed 000 Sec. 2.4, Eq. 3).
+struct VelocityConditionConfig {
+  std::string name;
+  int face = -1;                         ///< 2*axis + side of a grid face; -1 = none
+  std::vector<double> box_min, box_max;  ///< D values each, or empty
+  int plane_axis = -1;                   ///< nodes on the plane x_axis = plane_at; -1 = none
+  double plane_at = 0.0;
+  std::vector<double> direction;         ///< D values, unit length
+  std::string velocity = "0";            ///< value along direction: expression in t
+  TimeTable table;                       ///< factor of velocity; empty = 1
+  SourceLocation where;
+};
+
+enum class WallGradient { zero, given, estimate };
+
+/// [[wall]]: a moving wall normal to an axis (seed 000 Sec. 2.5, Eq. 4, Fig. 1B).
+struct WallConfig {
+  std::string name;
+  int axis = 0;
+  bool inside_below = true;       ///< the material lies at coordinates below the wall
+  double position = 0.0;          ///< wall position at t = 0
+  std::string velocity = "0";     ///< v_b(t) along the axis: expression in t
+  TimeTable table;                ///< factor of velocity; empty = 1
+  WallGradient gradient = WallGradient::zero;
+  std::string gradient_expression = "0";  ///< given gradient: expression in t
+  double depth = 1.0;             ///< d, in cells along the axis
+  SourceLocation where;
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -123,6 +168,9 @@ struct Config {
   std::vector<BodyConfig> bodies;
   BoundaryConfig boundary;
   BodyForceConfig body_force;
+  std::vector<TractionConfig> tractions;                   ///< [[traction]]
+  std::vector<VelocityConditionConfig> velocity_conditions;///< [[velocity]]
+  std::vector<WallConfig> walls;                           ///< [[wall]]
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
   OutputConfig output;
 };

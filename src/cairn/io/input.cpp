@@ -219,6 +219,12 @@ std::string mode_name(Mode m) {
 }
 
 const char* const face_names[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+
+/// The sections written as arrays of tables ([[material]], ...), addressed by index in --set.
+bool is_table_array(const std::string& section) {
+  return section == "material" || section == "body" || section == "traction" ||
+         section == "velocity" || section == "wall";
+}
 const char* const face_condition_names[4] = {"free", "fixed", "symmetry", "periodic"};
 
 /// " (one per axis, dimension 2)" when n is the dimension.
@@ -265,6 +271,8 @@ class TableReader {
   [[nodiscard]] std::vector<int> integers(const std::string& name, std::size_t n, bool allow_scalar);
   /// n entries, numbers or non-empty strings, as expression text; empty when absent.
   [[nodiscard]] std::vector<std::string> expressions(const std::string& name, std::size_t n);
+  /// One number or non-empty expression string, as expression text.
+  [[nodiscard]] std::string expression(const std::string& name);
   /// At least min_count points of n coordinates each ([[x, y], ...]).
   [[nodiscard]] std::vector<std::vector<double>> points(const std::string& name, std::size_t n,
                                                         std::size_t min_count);
@@ -346,6 +354,16 @@ class Loader {
   BodyShapeConfig read_shape(TableReader& body);
   void read_boundary(const toml::table& root, Config& cfg);
   void read_body_force(const toml::table& root, Config& cfg);
+  void read_tractions(const toml::table& root, Config& cfg);
+  void read_velocity_conditions(const toml::table& root, Config& cfg);
+  void read_walls(const toml::table& root, Config& cfg);
+  /// box_min/box_max of a selection: both or neither, max >= min on every axis.
+  void read_box(TableReader& r, std::vector<double>& lo, std::vector<double>& hi);
+  TimeTable read_table(TableReader& r);
+  /// A name for the N-th entry of an array of tables: the given one or <prefix><N>; unique
+  /// among `used`.
+  std::string entry_name(TableReader& r, const std::string& prefix, std::size_t index,
+                         std::vector<std::string>& used);
   void read_output(const toml::table& root, Config& cfg);
 
   const toml::table* section(const toml::table& root, const std::string& name) const {
@@ -355,6 +373,7 @@ class Loader {
   std::string file_;
   std::vector<std::pair<Path, std::string>> overrides_;  ///< path -> "--set <text>"
   std::deque<toml::table> defaults_;
+  std::vector<std::string> condition_names_;  ///< [[velocity]] and [[wall]] names (history columns)
   int dim_ = 0;
 };
 
@@ -548,6 +567,17 @@ std::vector<std::string> TableReader::expressions(const std::string& name, std::
   return out;
 }
 
+std::string TableReader::expression(const std::string& name) {
+  Value v = required_value(name);
+  const std::string expected = expected_value_text(*v.decl);
+  if (auto s = v.node->as_string()) {
+    if (trim(s->get()).empty()) fail(name, v.node, expected, "an empty string");
+    return s->get();
+  }
+  if (v.node->is_number()) return expression_number(number(v, path_of(name), expected));
+  fail(name, v.node, expected, found(v, true));
+}
+
 std::vector<std::vector<double>> TableReader::points(const std::string& name, std::size_t n,
                                                      std::size_t min_count) {
   Value v = value(name);
@@ -649,7 +679,7 @@ void Loader::apply_override(toml::table& root, const std::string& text) {
 
   toml::table* target = nullptr;
   std::size_t first = 1;  // index in p of the first key inside `target`
-  if (name == "material" || name == "body") {
+  if (is_table_array(name)) {
     const std::string example = fmt::format("an entry index, as in {0}.0.name or {0}[0].name", name);
     if (!is_index(p[1])) throw InputError(origin, 0, display(p), example, toml_string(p[1]));
     if (p.size() < 3) throw InputError(origin, 0, "", syntax, fmt::format("key {}", toml_string(lhs)));
@@ -736,7 +766,7 @@ void Loader::check_top_level(const toml::table& root) const {
         expected = "a section, one of " + join(sections) + did_you_mean(key, sections);
       fail({key}, node, expected, node->is_table() ? "an unknown table" : "an undeclared key");
     }
-    if (key == "material" || key == "body") {
+    if (is_table_array(key)) {
       const auto* a = node->as_array();
       const bool tables = a && std::all_of(a->begin(), a->end(), [](const toml::node& n) { return n.is_table(); });
       if (!tables)
@@ -1059,6 +1089,185 @@ void Loader::read_body_force(const toml::table& root, Config& cfg) {
   cfg.body_force.expression = r.expressions("expression", static_cast<std::size_t>(dim_));
 }
 
+std::string Loader::entry_name(TableReader& r, const std::string& prefix, std::size_t index,
+                               std::vector<std::string>& used) {
+  const std::string name = r.present("name") ? r.string("name") : fmt::format("{}{}", prefix, index);
+  const bool ok = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+  if (!ok) r.fail("name", r.given("name"), "a non-empty name of letters, digits, _ and -", toml_string(name));
+  if (std::find(used.begin(), used.end(), name) != used.end())
+    r.fail("name", r.given("name"), fmt::format("a name not used by another [[{}]]{}", prefix,
+                                                prefix == "traction" ? "" : " or [[velocity]]/[[wall]]"),
+           toml_string(name));
+  used.push_back(name);
+  return name;
+}
+
+void Loader::read_box(TableReader& r, std::vector<double>& lo, std::vector<double>& hi) {
+  if (r.present("box_min") != r.present("box_max")) {
+    const std::string missing = r.present("box_min") ? "box_max" : "box_min";
+    r.fail(missing, nullptr, "box_min and box_max together", "only one of them");
+  }
+  if (!r.present("box_min")) return;
+  const auto n = static_cast<std::size_t>(dim_);
+  lo = r.reals("box_min", n, false);
+  hi = r.reals("box_max", n, false);
+  for (std::size_t a = 0; a < n; ++a)
+    if (hi[a] < lo[a])
+      r.fail("box_max", r.given("box_max"), "box_max >= box_min on every axis",
+             fmt::format("box_max {} < box_min {} on axis {}", real_text(hi[a]), real_text(lo[a]), "xyz"[a]));
+}
+
+TimeTable Loader::read_table(TableReader& r) {
+  TimeTable table;
+  if (!r.present("table")) return table;
+  for (const auto& point : r.points("table", 2, 1)) table.emplace_back(point[0], point[1]);
+  for (std::size_t k = 1; k < table.size(); ++k)
+    if (!(table[k].first > table[k - 1].first))
+      r.fail("table", r.given("table"), "points [t, f] with increasing t",
+             fmt::format("t = {} after t = {}", real_text(table[k].first), real_text(table[k - 1].first)));
+  return table;
+}
+
+namespace {
+/// Index of `name` in `names`, or -1.
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+const std::vector<std::string> axis_letters{"x", "y", "z"};
+const std::vector<std::string> all_faces{"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+}  // namespace
+
+void Loader::read_tractions(const toml::table& root, Config& cfg) {
+  const toml::array* entries = root.get_as<toml::array>("traction");
+  if (!entries) return;
+  const auto n = static_cast<std::size_t>(dim_);
+  std::vector<std::string> used, bodies;
+  for (const auto& b : cfg.bodies) bodies.push_back(b.name);
+  const std::vector<std::string> faces(all_faces.begin(), all_faces.begin() + 2 * dim_);
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* t = entries->get(i)->as_table();
+    const Path path = child(Path{"traction"}, i);
+    TableReader r(*this, t, path, copy_section("traction"), "[[traction]]");
+    r.reject_unknown_keys();
+    TractionConfig c;
+    c.name = entry_name(r, "traction", i, used);
+    c.body = r.string("body");
+    if (!c.body.empty() && index_of(bodies, c.body) < 0)
+      r.fail("body", r.given("body"),
+             "\"\" or the name of a [[body]], one of " + join(bodies) + did_you_mean(c.body, bodies),
+             toml_string(c.body));
+    if (r.present("side")) {
+      const std::string side = r.string("side");
+      c.side = index_of(faces, side);
+      if (c.side < 0)
+        r.fail("side", r.given("side"), fmt::format("a side of the {}D grid, one of {}", dim_, join(faces)),
+               toml_string(side));
+    }
+    read_box(r, c.box_min, c.box_max);
+    if (c.side < 0 && c.box_min.empty())
+      fail(path, t, "side, or box_min and box_max, to select the loaded faces", "neither");
+    c.traction = r.reals("traction", n, false);
+    c.scale = r.expression("scale");
+    c.table = read_table(r);
+    c.where = {file_, line_of(t)};
+    cfg.tractions.push_back(std::move(c));
+  }
+}
+
+void Loader::read_velocity_conditions(const toml::table& root, Config& cfg) {
+  const toml::array* entries = root.get_as<toml::array>("velocity");
+  if (!entries) return;
+  const auto n = static_cast<std::size_t>(dim_);
+  const std::vector<std::string> faces(all_faces.begin(), all_faces.begin() + 2 * dim_);
+  const std::vector<std::string> axes(axis_letters.begin(), axis_letters.begin() + dim_);
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* t = entries->get(i)->as_table();
+    const Path path = child(Path{"velocity"}, i);
+    TableReader r(*this, t, path, copy_section("velocity"), "[[velocity]]");
+    r.reject_unknown_keys();
+    VelocityConditionConfig c;
+    c.name = entry_name(r, "velocity", i, condition_names_);
+    if (r.present("face")) {
+      const std::string face = r.string("face");
+      c.face = index_of(faces, face);
+      if (c.face < 0)
+        r.fail("face", r.given("face"), fmt::format("a face of the {}D grid, one of {}", dim_, join(faces)),
+               toml_string(face));
+      if (cfg.boundary.face[c.face] == FaceCondition::periodic)
+        r.fail("face", r.given("face"), "a face that is not periodic ([boundary])", toml_string(face));
+    }
+    read_box(r, c.box_min, c.box_max);
+    if (r.present("plane_axis") != r.present("plane_at")) {
+      const std::string missing = r.present("plane_axis") ? "plane_at" : "plane_axis";
+      r.fail(missing, nullptr, "plane_axis and plane_at together", "only one of them");
+    }
+    if (r.present("plane_axis")) {
+      const std::string axis = r.string("plane_axis");
+      c.plane_axis = index_of(axes, axis);
+      if (c.plane_axis < 0)
+        r.fail("plane_axis", r.given("plane_axis"), fmt::format("an axis of the {}D grid, one of {}", dim_, join(axes)),
+               toml_string(axis));
+      c.plane_at = r.real("plane_at");
+    }
+    if (c.face < 0 && c.box_min.empty() && c.plane_axis < 0)
+      fail(path, t, "face, box_min/box_max or plane_axis/plane_at to select the nodes", "none of them");
+    c.direction = r.reals("direction", n, false);
+    double norm = 0.0;
+    for (double d : c.direction) norm += d * d;
+    if (!(norm > 0.0)) r.fail("direction", r.given("direction"), "a non-zero direction", "all zeros");
+    for (double& d : c.direction) d /= std::sqrt(norm);
+    c.velocity = r.expression("velocity");
+    c.table = read_table(r);
+    c.where = {file_, line_of(t)};
+    cfg.velocity_conditions.push_back(std::move(c));
+  }
+}
+
+void Loader::read_walls(const toml::table& root, Config& cfg) {
+  const toml::array* entries = root.get_as<toml::array>("wall");
+  if (!entries) return;
+  const std::vector<std::string> axes(axis_letters.begin(), axis_letters.begin() + dim_);
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* t = entries->get(i)->as_table();
+    const Path path = child(Path{"wall"}, i);
+    TableReader r(*this, t, path, copy_section("wall"), "[[wall]]");
+    r.reject_unknown_keys();
+    WallConfig c;
+    c.name = entry_name(r, "wall", i, condition_names_);
+    const std::string axis = r.string("axis");
+    c.axis = index_of(axes, axis);
+    if (c.axis < 0)
+      r.fail("axis", r.given("axis"), fmt::format("an axis of the {}D grid, one of {}", dim_, join(axes)),
+             toml_string(axis));
+    if (cfg.boundary.face[2 * c.axis] == FaceCondition::periodic)
+      r.fail("axis", r.given("axis"), "an axis that is not periodic ([boundary])", toml_string(axis));
+    c.inside_below = r.string("inside") == "below";
+    c.position = r.real("position");
+    const double lo = cfg.grid.origin[c.axis], hi = lo + cfg.grid.extent[c.axis];
+    if (c.position < lo || c.position > hi)
+      r.fail("position", r.given("position"),
+             fmt::format("a wall position inside the grid along {}, in [{}, {}]", axis, real_text(lo), real_text(hi)),
+             real_text(c.position));
+    c.velocity = r.expression("velocity");
+    c.table = read_table(r);
+    const std::string gradient = r.expression("gradient");
+    if (gradient == "zero") {
+      c.gradient = WallGradient::zero;
+    } else if (gradient == "estimate") {
+      c.gradient = WallGradient::estimate;
+    } else {
+      c.gradient = WallGradient::given;
+      c.gradient_expression = gradient;
+    }
+    c.depth = r.real("depth");
+    c.where = {file_, line_of(t)};
+    cfg.walls.push_back(std::move(c));
+  }
+}
+
 void Loader::read_output(const toml::table& root, Config& cfg) {
   TableReader r(*this, section(root, "output"), {"output"}, copy_section("output"), "[output]");
   r.reject_unknown_keys();
@@ -1089,6 +1298,9 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   read_bodies(root, cfg);
   read_boundary(root, cfg);
   read_body_force(root, cfg);
+  read_tractions(root, cfg);
+  read_velocity_conditions(root, cfg);
+  read_walls(root, cfg);
   read_output(root, cfg);
   cfg.resolved_toml = config_to_toml(cfg);
   return cfg;
@@ -1214,6 +1426,55 @@ std::string config_to_toml(const Config& c) {
   if (!c.body_force.expression.empty()) {
     o += "\n[body_force]\n";
     line("expression", array_text(c.body_force.expression, expression_text));
+  }
+
+  auto table_text = [](const TimeTable& table) {
+    std::string t = "[";
+    for (std::size_t k = 0; k < table.size(); ++k)
+      t += fmt::format("{}[{}, {}]", k ? ", " : "", real_text(table[k].first), real_text(table[k].second));
+    return t + "]";
+  };
+  for (const auto& t : c.tractions) {
+    o += "\n[[traction]]\n";
+    line("name", toml_string(t.name));
+    line("body", toml_string(t.body));
+    if (t.side >= 0) line("side", toml_string(face_names[t.side]));
+    if (!t.box_min.empty()) {
+      line("box_min", reals_text(t.box_min));
+      line("box_max", reals_text(t.box_max));
+    }
+    line("traction", reals_text(t.traction));
+    line("scale", expression_text(t.scale));
+    if (!t.table.empty()) line("table", table_text(t.table));
+  }
+  for (const auto& v : c.velocity_conditions) {
+    o += "\n[[velocity]]\n";
+    line("name", toml_string(v.name));
+    if (v.face >= 0) line("face", toml_string(face_names[v.face]));
+    if (!v.box_min.empty()) {
+      line("box_min", reals_text(v.box_min));
+      line("box_max", reals_text(v.box_max));
+    }
+    if (v.plane_axis >= 0) {
+      line("plane_axis", toml_string(std::string(1, "xyz"[v.plane_axis])));
+      line("plane_at", real_text(v.plane_at));
+    }
+    line("direction", reals_text(v.direction));
+    line("velocity", expression_text(v.velocity));
+    if (!v.table.empty()) line("table", table_text(v.table));
+  }
+  for (const auto& w : c.walls) {
+    o += "\n[[wall]]\n";
+    line("name", toml_string(w.name));
+    line("axis", toml_string(std::string(1, "xyz"[w.axis])));
+    line("inside", toml_string(w.inside_below ? "below" : "above"));
+    line("position", real_text(w.position));
+    line("velocity", expression_text(w.velocity));
+    if (!w.table.empty()) line("table", table_text(w.table));
+    line("gradient", w.gradient == WallGradient::zero       ? toml_string("zero")
+                     : w.gradient == WallGradient::estimate ? toml_string("estimate")
+                                                            : expression_text(w.gradient_expression));
+    line("depth", real_text(w.depth));
   }
 
   const auto& out = c.output;

@@ -18,6 +18,7 @@ enum class KeyType {
   integer_array,   ///< array of integers (e.g. particles_per_cell)
   real_array,      ///< array of numbers (e.g. origin)
   expression_array,///< array whose entries are numbers or expression strings in x,y,z,X,Y,Z,t
+  expression,      ///< one number or expression string (e.g. a time function in t)
   string_array,
   table,           ///< an inline table (e.g. a body's shape)
 };

@@ -16,6 +16,8 @@ namespace {
 
 std::vector<std::string> face_conditions() { return {"free", "fixed", "symmetry", "periodic"}; }
 std::vector<std::string> boundary_acceleration_names() { return {"zero", "velocity_change"}; }
+std::vector<std::string> face_names_list() { return {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}; }
+std::vector<std::string> axis_names() { return {"x", "y", "z"}; }
 std::vector<std::string> mode_names() { return {"plane_strain", "plane_stress", "3d", "uniaxial"}; }
 
 /// Fluent construction of a KeyDecl (designated initializers that skip members warn under -Wextra).
@@ -272,6 +274,88 @@ std::vector<KeyDecl> make_declarations() {
                  "x, y, z (current position), X, Y, Z (reference position), t and "
                  "[constants]; default none."));
 
+  // [[traction]] (seed 000 Sec. 2.4, docs/boundary-conditions.md)
+  k.push_back(Key("traction", "name", T::string,
+                 "Name used in messages; default traction<N> for the N-th [[traction]] (from 0)."));
+  k.push_back(Key("traction", "body", T::string,
+                 "Name of the loaded [[body]]; \"\" = every body.")
+                .by_default("\"\""));
+  k.push_back(Key("traction", "side", T::string,
+                 "Load only the exposed particle faces with this outward normal (x_min: -x, ...); "
+                 "default every exposed face (then box_min/box_max are required).")
+                .choices(face_names_list));
+  k.push_back(Key("traction", "box_min", T::real_array,
+                 "With box_max: load only faces whose reference centre lies in this box."));
+  k.push_back(Key("traction", "box_max", T::real_array,
+                 "Upper corner of the face-selection box."));
+  k.push_back(Key("traction", "traction", T::real_array,
+                 "Traction vector (force per current face area), one entry per axis; multiplied "
+                 "by scale(t) and table(t).")
+                .required());
+  k.push_back(Key("traction", "scale", T::expression,
+                 "Time factor: an expression in t with tri(t, w), ramp(t, r) and [constants].")
+                .by_default("1.0"));
+  k.push_back(Key("traction", "table", T::real_array,
+                 "Piecewise-linear time factor [[t0, f0], [t1, f1], ...] (increasing t, constant "
+                 "beyond the ends), multiplied with scale; default none."));
+
+  // [[velocity]]
+  k.push_back(Key("velocity", "name", T::string,
+                 "Name used in history.csv (reaction_<name>_x, ...); default velocity<N>."));
+  k.push_back(Key("velocity", "face", T::string,
+                 "Select the nodes of this grid face and the ghost nodes beyond it.")
+                .choices(face_names_list));
+  k.push_back(Key("velocity", "box_min", T::real_array,
+                 "With box_max: select the nodes inside this box (a line or plane when the box is "
+                 "flat)."));
+  k.push_back(Key("velocity", "box_max", T::real_array,
+                 "Upper corner of the node-selection box."));
+  k.push_back(Key("velocity", "plane_axis", T::string,
+                 "With plane_at: select the nodes on the plane (2D: line) <plane_axis> = plane_at.")
+                .choices(axis_names));
+  k.push_back(Key("velocity", "plane_at", T::real,
+                 "Coordinate of the selection plane along plane_axis."));
+  k.push_back(Key("velocity", "direction", T::real_array,
+                 "Direction of the prescribed velocity component, one entry per axis (normalised).")
+                .required());
+  k.push_back(Key("velocity", "velocity", T::expression,
+                 "Prescribed velocity along direction: an expression in t with tri, ramp and "
+                 "[constants], times table(t).")
+                .by_default("0.0"));
+  k.push_back(Key("velocity", "table", T::real_array,
+                 "Piecewise-linear factor [[t0, f0], [t1, f1], ...] of velocity; default none."));
+
+  // [[wall]] (seed 000 Sec. 2.5)
+  k.push_back(Key("wall", "name", T::string,
+                 "Name used in history.csv (reaction_<name>_x, wall_<name>_position); default "
+                 "wall<N>."));
+  k.push_back(Key("wall", "axis", T::string,
+                 "The wall is normal to this axis and moves along it.")
+                .required()
+                .choices(axis_names));
+  k.push_back(Key("wall", "inside", T::string,
+                 "Side of the wall where the material is: below (coordinates < position) or above.")
+                .required()
+                .choices([] { return std::vector<std::string>{"below", "above"}; }));
+  k.push_back(Key("wall", "position", T::real,
+                 "Wall position along axis at t = 0; inside the grid.")
+                .required());
+  k.push_back(Key("wall", "velocity", T::expression,
+                 "Wall velocity v_b(t) along axis: an expression in t, times table(t); the wall "
+                 "moves with it.")
+                .by_default("0.0"));
+  k.push_back(Key("wall", "table", T::real_array,
+                 "Piecewise-linear factor [[t0, f0], [t1, f1], ...] of velocity; default none."));
+  k.push_back(Key("wall", "gradient", T::expression,
+                 "Velocity gradient along axis: \"zero\", \"estimate\" (seed 000 Eq. 4) or "
+                 "an expression in t.")
+                .by_default("\"zero\""));
+  k.push_back(Key("wall", "depth", T::real,
+                 "Depth d in cells: nodes inside the material within d of the wall are "
+                 "controlled (seed 000 Sec. 2.5).")
+                .by_default("1.0")
+                .min(above_zero));
+
   // [output]
   k.push_back(Key("output", "directory", T::string,
                  "Output folder; \"\" = out/<input file stem>.")
@@ -306,6 +390,9 @@ const std::map<std::string, std::string>& computed_defaults() {
       {"simulation.mode", "by dimension"},
       {"body.name", "body<N>"},
       {"body.velocity", "zeros"},
+      {"traction.name", "traction<N>"},
+      {"velocity.name", "velocity<N>"},
+      {"wall.name", "wall<N>"},
   };
   return m;
 }
@@ -320,6 +407,9 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.annulus.center", "real[2]"},
       {"body.shape.sphere.center", "real[3]"},
       {"body.shape.polygon.vertices", "real[2][n]"},
+      {"traction.table", "real[2][n]"},
+      {"velocity.table", "real[2][n]"},
+      {"wall.table", "real[2][n]"},
   };
   return m;
 }
@@ -433,6 +523,39 @@ const std::vector<SectionDoc>& section_docs() {
        "A body force per unit mass (e.g. gravity), applied to every particle.",
        "[body_force]\n"
        "expression = [0.0, \"-9.81\"]\n"},
+      {"traction", "[[traction]]",
+       "A traction on the exposed faces of a body's particles, added to the grid forces (seed 000 "
+       "Sec. 2.4): T(t) = traction * scale(t) * table(t), spread with the grid functions over each "
+       "face; the face area follows the deformation with cpdi, b2cpdi and cpgimp. Faces are "
+       "selected by side, by box or both. See docs/boundary-conditions.md.",
+       "[[traction]]\n"
+       "body = \"bar\"\n"
+       "side = \"x_min\"\n"
+       "traction = [-500.0, 0.0]\n"
+       "scale = \"tri(t, 1e-3)\"\n"},
+      {"velocity", "[[velocity]]",
+       "A prescribed grid velocity component on a node set: the intersection of the selectors "
+       "given (face, box, plane). Imposed with the [boundary] faces in every scheme, including the "
+       "velocity, lumped and combined full-mass methods (seed 000 Eq. 3); its reaction force is in "
+       "history.csv. See docs/boundary-conditions.md.",
+       "[[velocity]]\n"
+       "name = \"grip\"\n"
+       "face = \"x_max\"\n"
+       "direction = [1.0, 0.0]\n"
+       "velocity = \"0.01*ramp(t, 1e-3)\"\n"},
+      {"wall", "[[wall]]",
+       "A moving wall normal to an axis (seed 000 Sec. 2.5): it sets v = v_b + grad v_b (x - "
+       "x_wall) along its axis on the nodes inside the material within depth d and on the nodes "
+       "outside it that carry mass. Its position and reaction force are in history.csv. See "
+       "docs/boundary-conditions.md.",
+       "[[wall]]\n"
+       "name = \"right\"\n"
+       "axis = \"x\"\n"
+       "inside = \"below\"\n"
+       "position = 10.0\n"
+       "velocity = 0.025\n"
+       "gradient = \"estimate\"\n"
+       "depth = 1.5\n"},
       {"output", "[output]",
        "What is written, where and how often.",
        "[output]\n"
@@ -644,7 +767,8 @@ std::vector<const KeyDecl*> section_keys(std::string_view section) {
 const std::vector<std::string>& section_names() {
   static const std::vector<std::string> names{"simulation", "grid",     "method",
                                               "constants",  "material", "body",
-                                              "boundary",   "body_force", "output"};
+                                              "boundary",   "body_force", "traction",
+                                              "velocity",   "wall",       "output"};
   return names;
 }
 
@@ -683,6 +807,7 @@ std::string expected_value_text(const KeyDecl& d) {
     case KeyType::integer_array: return "an array of integers" + (range.empty() ? "" : ", each" + range);
     case KeyType::real_array: return "an array of numbers" + (range.empty() ? "" : ", each" + range);
     case KeyType::expression_array: return "an array of numbers or expression strings";
+    case KeyType::expression: return "a number or an expression string";
     case KeyType::string_array: return "an array of strings";
     case KeyType::table: return "a table";
   }
@@ -700,6 +825,7 @@ std::string type_text(const KeyDecl& d) {
     case KeyType::integer_array: return "integer[D]";
     case KeyType::real_array: return "real[D]";
     case KeyType::expression_array: return "expr[D]";
+    case KeyType::expression: return "expr";
     case KeyType::string_array: return "string[]";
     case KeyType::table: return "table";
   }

@@ -191,6 +191,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9);
       h5::write_doubles(gid, "pressure", pressure.data(), n);
       h5::write_doubles(gid, "von_mises", von_mises.data(), n);
+      h5::write_doubles(gid, "temperature", particles.temperature.data(), n);
       h5::write_ints(gid, "material", particles.material.data(), n);
       h5::write_ints(gid, "body", particles.body.data(), n);
     }
@@ -288,6 +289,7 @@ void SnapshotWriter<D>::write_xdmf() {
               "/particles/deformation_gradient");
     attribute(parts, "pressure", "Scalar", n, false, file, "/particles/pressure");
     attribute(parts, "von_mises", "Scalar", n, false, file, "/particles/von_mises");
+    attribute(parts, "temperature", "Scalar", n, false, file, "/particles/temperature");
     attribute(parts, "material", "Scalar", n, true, file, "/particles/material");
     attribute(parts, "body", "Scalar", n, true, file, "/particles/body");
     parts.append(std::string_view("      </Grid>\n"));

@@ -24,6 +24,10 @@ struct MaterialPoint {
   const Mat3& L;       ///< velocity gradient of this step (3x3)
   double* state;       ///< the particle's state variables (model-defined length)
   double dt;
+  const Mat3* dF = nullptr;       ///< this step's increment exp(L dt), when known
+  const Mat3* tau_old = nullptr;  ///< Kirchhoff stress before this update, when known
+  double cell_size = 0.0;         ///< grid cell size (artificial viscosity length)
+  double* temperature = nullptr;  ///< the particle's temperature, updated by thermal models
 };
 
 class Material {
@@ -40,6 +44,16 @@ class Material {
   [[nodiscard]] virtual Mat3 kirchhoff(const Mat3& F) const = 0;
   /// Strain energy per unit reference volume W(F).
   [[nodiscard]] virtual double energy_density(const Mat3& F) const = 0;
+  /// Stored plus dissipated internal energy per unit reference volume; path-dependent models
+  /// read it from their state (e.g. rho0 U for the Mie-Grueneisen model). Defaults to W(F).
+  [[nodiscard]] virtual double internal_energy_density(const Mat3& F, const double* state) const {
+    (void)state;
+    return energy_density(F);
+  }
+  /// Initial values of the state variables (n_state() of them).
+  virtual void initialize_state(double* state) const { (void)state; }
+  /// Initial particle temperature (0 for models without a thermal part).
+  [[nodiscard]] virtual double initial_temperature() const { return 0.0; }
   /// Speed of the fastest wave at deformation F, used by the CFL time step.
   [[nodiscard]] virtual double wave_speed(const Mat3& F) const = 0;
 

@@ -23,6 +23,7 @@ struct Particles {
   std::vector<Mat3> kirchhoff_stress;   ///< tau = J sigma (3x3 always)
   std::vector<Mat3> velocity_gradient;  ///< last grad V_p extrapolated from the grid (diagnostic)
   std::vector<Mat3> affine_velocity;    ///< APIC affine matrix C_p (top-left DxD used; else zero)
+  std::vector<double> temperature;      ///< temperature (thermal models; 0 where unused)
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
@@ -42,6 +43,7 @@ struct Particles {
     kirchhoff_stress.resize(n, Mat3::Zero());
     velocity_gradient.resize(n, Mat3::Zero());
     affine_velocity.resize(n, Mat3::Zero());
+    temperature.resize(n, 0.0);
     material.resize(n);
     body.resize(n);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
@@ -60,6 +62,7 @@ struct Particles {
     kirchhoff_stress.push_back(Mat3::Zero());
     velocity_gradient.push_back(Mat3::Zero());
     affine_velocity.push_back(Mat3::Zero());
+    temperature.push_back(0.0);
     material.push_back(mat);
     body.push_back(bod);
     state.resize(state.size() + static_cast<std::size_t>(n_state_per_particle), 0.0);

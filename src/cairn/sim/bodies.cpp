@@ -94,6 +94,12 @@ void create_particles(const Config& config, const Grid<D>& grid,
       if (!inside<D>(body.shape, X)) continue;
       const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
       particles.add(X, v0, mass, vol, lp, mat, static_cast<std::int32_t>(b));
+      {
+        const std::size_t p = particles.n() - 1;
+        particles.temperature[p] = materials[mat]->initial_temperature();
+        if (particles.n_state_per_particle > 0)
+          materials[mat]->initialize_state(&particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]);
+      }
       if (displacement) {
         const std::size_t p = particles.n() - 1;
         particles.position[p] = X + (*displacement)(X, X, 0.0);
@@ -118,7 +124,9 @@ void create_particles(const Config& config, const Grid<D>& grid,
   for (std::size_t p = 0; p < particles.n(); ++p) {
     if (particles.deformation_gradient[p].isIdentity(0.0)) continue;
     const Mat3 L = Mat3::Zero();
-    double* state = nullptr;
+    double* state = particles.n_state_per_particle
+                        ? &particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]
+                        : nullptr;
     const MaterialPoint point{particles.deformation_gradient[p], L, state, 0.0};
     particles.kirchhoff_stress[p] = materials[particles.material[p]]->update(point);
   }

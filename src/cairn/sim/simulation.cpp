@@ -64,6 +64,8 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   for (double m : particles_.mass) max_mass = std::max(max_mass, m);
   small_mass_ = 1e-15 * max_mass;  // nodes below this hold no velocity
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
+  velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
+  tractions_ = Tractions<D>(config_, grid_, particles_);
 
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
@@ -155,6 +157,7 @@ void Simulation<D>::step(double dt) {
   if (stress_first) {
     // USF / USAVG: update stresses from v = m^-1 p (m~_k^-1 p under FMPM) before the forces.
     particles_to_grid(true, false);
+    velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
     lap(1);
     stress_velocity_from_momentum(nodes_.momentum, fmpm_velocities);
     lap(3);
@@ -163,6 +166,7 @@ void Simulation<D>::step(double dt) {
     particles_to_grid(false, true);
   } else {
     particles_to_grid(true, true);
+    velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
   }
   lap(1);
   update_grid(dt);
@@ -194,6 +198,7 @@ void Simulation<D>::step(double dt) {
       break;
   }
   lap(5);
+  velocity_conditions_.finish_step();
   time_ += dt;
   ++step_;
 }
@@ -274,6 +279,8 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       }
     }
   });
+  // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
+  if (forces) tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force);
 }
 
 template <int D>
@@ -293,10 +300,13 @@ void Simulation<D>::update_grid(double dt) {
     }
   });
   conditions_.apply_step(nodes_, dt);
+  velocity_conditions_.apply_step(nodes_, dt, config_.boundary.acceleration == BoundaryAcceleration::zero);
 
-  // External work of this step: body forces and reactions at the mean grid velocity.
+  // External work of this step: body forces, tractions and reactions at the mean grid velocity.
   const bool has_body_force = !body_force_.empty();
-  if (has_body_force || !conditions_.empty()) {
+  if (!tractions_.empty())
+    external_work_ += 0.5 * dt * (tractions_.power(nodes_.velocity) + tractions_.power(nodes_.velocity_new));
+  if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
     external_work_ += dt * chunked_sum<double>(grid_.n_nodes(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
       double w = nodes_.reaction[i].dot(v_mean);
@@ -337,7 +347,8 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
   // The uncorrected start is rebuilt from the step's p (and f) when `in` is one of the step's
   // own grid velocities; stress-update velocities (USF, USL+) start from their corrected value.
   const bool from_p = &in == &nodes_.velocity, from_p_new = &in == &nodes_.velocity_new;
-  const bool uncorrected_start = method == "velocity" && !conditions_.empty() && (from_p || from_p_new);
+  const bool uncorrected_start = method == "velocity" && (!conditions_.empty() || !velocity_conditions_.empty()) &&
+                                 (from_p || from_p_new);
   for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (!uncorrected_start) grid_term_[i] = in[i];
@@ -352,7 +363,14 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
       out[i] += grid_term_[i];
     });
   }
-  if (method != "lumped") conditions_.apply(out, nodes_.mass, nullptr, 1.0);
+  using When = typename VelocityConditions<D>::When;
+  if (method != "lumped") impose_conditions(out, from_p ? When::start : from_p_new ? When::end : work_when_);
+}
+
+template <int D>
+void Simulation<D>::impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when) {
+  conditions_.apply(velocity, nodes_.mass, nullptr, 1.0);
+  velocity_conditions_.apply(velocity, when);
 }
 
 template <int D>
@@ -361,7 +379,10 @@ void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& mom
     const double m = nodes_.mass[i];
     nodes_.velocity_work[i] = m > small_mass_ ? Vec<D>(momentum[i] / m) : Vec<D>::Zero();
   });
-  conditions_.apply(nodes_.velocity_work, nodes_.mass, nullptr, 1.0);
+  // USF/USAVG start from p (start-of-step values), USL+/USAVG+ from S^T M V^(n+1) (end values).
+  using When = typename VelocityConditions<D>::When;
+  work_when_ = &momentum == &nodes_.momentum ? When::start : When::end;
+  impose_conditions(nodes_.velocity_work, work_when_);
   if (full_mass) {
     std::vector<Vec<D>>& tmp = nodes_.velocity_full;  // free at this point of the step
     full_mass_velocity(nodes_.velocity_work, tmp, config_.method.order);
@@ -428,12 +449,16 @@ void Simulation<D>::update_particles(double dt) {
 }
 
 template <int D>
-Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, double dt) {
+Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
   double* state = particles_.n_state_per_particle
                       ? &particles_.state[p * static_cast<std::size_t>(particles_.n_state_per_particle)]
                       : nullptr;
-  const MaterialPoint point{F, L, state, dt};
+  MaterialPoint point{F, L, state, dt};
+  point.dF = &dF;
+  point.tau_old = &particles_.kirchhoff_stress[p];
+  point.cell_size = grid_.min_cell_size();
+  point.temperature = &particles_.temperature[p];
   const Material& m = *materials_[particles_.material[p]];
   if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
   return m.update(point);
@@ -450,8 +475,9 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
       L.template topLeftCorner<D, D>() += grid_velocity[cache_.node[s]] * cache_.gradient[s].transpose();
     particles_.velocity_gradient[p] = L;
     Mat3& F = particles_.deformation_gradient[p];
-    F = tensor_exp(L * dt) * F;
-    particles_.kirchhoff_stress[p] = stress_for(static_cast<std::size_t>(p), L, dt);
+    const Mat3 dF = tensor_exp(L * dt);
+    F = dF * F;
+    particles_.kirchhoff_stress[p] = stress_for(static_cast<std::size_t>(p), L, dF, dt);
     const double J = F.determinant();
     const char* bad = nullptr;
     if (!particles_.velocity[p].allFinite()) bad = "velocity";
@@ -486,7 +512,8 @@ Totals Simulation<D>::totals() const {
     return 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
   });
   t.strain_energy = chunked_sum<double>(n, 0.0, [&](std::int64_t p) {
-    return P.volume0[p] * materials_[P.material[p]]->energy_density(P.deformation_gradient[p]);
+    const double* state = P.n_state_per_particle ? &P.state[p * static_cast<std::size_t>(P.n_state_per_particle)] : nullptr;
+    return P.volume0[p] * materials_[P.material[p]]->internal_energy_density(P.deformation_gradient[p], state);
   });
   t.momentum = chunked_sum<Vec3>(n, Vec3::Zero(), [&](std::int64_t p) {
     return Vec3(to3<D>(P.mass[p] * P.velocity[p]));

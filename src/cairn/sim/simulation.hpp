@@ -10,6 +10,8 @@
 
 #include "cairn/bc/expression.hpp"
 #include "cairn/bc/grid_conditions.hpp"
+#include "cairn/bc/traction.hpp"
+#include "cairn/bc/velocity_conditions.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
 #include "cairn/materials/material.hpp"
@@ -86,15 +88,26 @@ class Simulation {
   }
   [[nodiscard]] Totals totals() const;
 
+  // ---- loads and velocity conditions (docs/boundary-conditions.md) ---------------------------
+  /// [[velocity]] node sets and [[wall]] moving walls (names, reactions, wall positions).
+  [[nodiscard]] const VelocityConditions<D>& velocity_conditions() const { return velocity_conditions_; }
+  [[nodiscard]] VelocityConditions<D>& velocity_conditions() { return velocity_conditions_; }
+  [[nodiscard]] const Tractions<D>& tractions() const { return tractions_; }
+  /// Notes raised by the step since the last call (e.g. two conditions on one node), each once.
+  std::vector<std::string> take_notes() { return velocity_conditions_.take_notes(); }
+
  private:
   void setup_grid();
   void compute_body_forces();
-  Mat3 stress_for(std::size_t p, const Mat3& L, double dt);
+  Mat3 stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
   [[nodiscard]] double max_signal_speed() const;
   /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
   /// with conditions, or m~_k^-1 q for FMPM.
   void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
   void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
+  /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
+  /// with the values of the start or the end of the step.
+  void impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when);
 
   Config config_;
   Mode mode_;
@@ -121,6 +134,10 @@ class Simulation {
   Vec<D> body_force_value_ = Vec<D>::Zero();
   std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step
   GridConditions<D> conditions_;           ///< velocity conditions from [boundary]
+  VelocityConditions<D> velocity_conditions_;  ///< [[velocity]] and [[wall]]
+  Tractions<D> tractions_;                 ///< [[traction]]
+  /// Which values a full-mass expansion of nodes_.velocity_work re-imposes (USF: start, USL+: end).
+  typename VelocityConditions<D>::When work_when_ = VelocityConditions<D>::When::start;
   double small_mass_ = 0.0;
   double time_ = 0.0;
   long long step_ = 0;

@@ -1,0 +1,94 @@
+// Tractions on particle faces (seed 000 Sec. 2.4, first equation):
+//     f_i^(T) = sum over loaded faces (p, s) of T_{p,s}(t) int_{A_s} N_i(x) dS,
+// added to the grid forces of Task 2, so that every particle update and stress-update timing
+// works unchanged (seed 000: "no changes are needed in FMPM").
+//
+// Faces. A [[traction]] selects, once at setup on the reference configuration, the exposed faces
+// of a body's particles: face s of particle p (normal -e_a or +e_a) is exposed when the body has
+// no particle in the neighbouring lattice site across it (bodies are filled on a lattice of
+// spacing h / ppc, sim/bodies.cpp). `side` keeps the faces of one outward normal, the box keeps
+// faces whose reference centre lies in it.
+//
+// Face geometry each step, by what the shape family tracks (docs/boundary-conditions.md):
+//   convected  (cpdi, b2cpdi): the domain x_p + F diag(l_p0/2) [-1, 1]^D, faces are the deformed
+//              parallelograms of CPDI (seed 000 Sec. 2.1, Sadeghirad et al. 2011);
+//   stretched  (cpgimp): the box l_p0 diag(F) (seed 003 Sec. 3.3);
+//   undeformed (every other family): the initial box l_p0 translated to x_p.
+// The area A_s is that of the face (times the thickness in 2D, the cross-section in 1D).
+//
+// Integral. int_{A_s} N_i dS is evaluated by 3-point Gauss-Legendre rules along each face
+// direction. N_i at a Gauss point is read from the shape family itself, by building its stencil
+// for zero-size proxy particles placed at the Gauss points: with a vanishing particle domain
+// every family's S_pi reduces to its grid function N_i(x) (GIMP convolutions of width 0, CPDI
+// domains collapsed to one corner, B-splines and open-knot splines as they are). The proxies'
+// gradients are not used. Exception: uGIMP with a fixed method.smoothing_length keeps that width,
+// so its tractions are spread with the smoothed functions.
+//
+// The traction vector is fixed in space (it does not turn with the face) and is evaluated at the
+// middle of the step, t + dt/2, so that the impulse of a step is second-order accurate.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cairn/bc/time_function.hpp"
+#include "cairn/grid/grid.hpp"
+#include "cairn/io/config.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/shapes/shape_family.hpp"
+#include "cairn/transfer/cache.hpp"
+
+namespace cairn {
+
+/// How the particle domain used for face areas follows the deformation.
+enum class ParticleDomain { undeformed, stretched, convected };
+
+/// The domain a registered shape family tracks: convected for cpdi/b2cpdi, stretched for cpgimp,
+/// undeformed otherwise.
+ParticleDomain particle_domain_of(const std::string& shape_family);
+
+template <int D>
+class Tractions {
+ public:
+  Tractions() = default;
+  /// Select the loaded faces of every [[traction]]. Throws std::invalid_argument naming the
+  /// traction and its line when one selects no face or its scale does not parse.
+  Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles);
+
+  [[nodiscard]] bool empty() const { return loads_.empty(); }
+  /// Number of faces loaded by traction `k`.
+  [[nodiscard]] std::size_t n_faces(std::size_t k) const { return loads_[k].n_faces; }
+
+  /// force_i += f_i^(T) at time t for the current particle configuration.
+  void add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
+                  double t, std::vector<Vec<D>>& force);
+  /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v).
+  [[nodiscard]] double power(const std::vector<Vec<D>>& v) const;
+  /// Total force of traction k at the last add_forces (sum over its faces of T A_s).
+  [[nodiscard]] Vec<D> total_force(std::size_t k) const { return loads_[k].total; }
+
+ private:
+  struct Face {
+    std::int32_t particle;
+    std::int16_t axis;  ///< normal axis a
+    std::int16_t sign;  ///< -1: the min face, +1: the max face
+    std::int32_t load;  ///< index into loads_
+  };
+  struct Load {
+    Vec<D> traction = Vec<D>::Zero();
+    TimeFunction factor;
+    std::size_t n_faces = 0;
+    Vec<D> total = Vec<D>::Zero();
+  };
+
+  std::vector<Face> faces_;
+  std::vector<Load> loads_;
+  ParticleDomain domain_ = ParticleDomain::undeformed;
+  double thickness_ = 1.0;
+  Particles<D> points_;              ///< zero-size proxies at the Gauss points of every face
+  std::vector<Vec<D>> point_force_;  ///< T w A of each Gauss point
+  TransferCache<D> cache_;           ///< the family's stencils of the proxies
+};
+
+}  // namespace cairn
