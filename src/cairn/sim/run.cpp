@@ -23,6 +23,19 @@ const std::vector<std::string> history_columns = {
     "kinetic_energy", "strain_energy", "external_work", "total_energy", "energy_error",
     "dissipated_energy", "momentum_x", "momentum_y", "momentum_z"};
 
+/// The columns of history.csv: the fixed ones, then per [[velocity]]/[[wall]] its reaction force
+/// reaction_<name>_<axis> (seed 000 Sec. 2.4, summed over its nodes, from the last step), then per
+/// wall its position wall_<name>_position.
+template <int D>
+std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
+  std::vector<std::string> columns = history_columns;
+  for (const auto& name : sim.velocity_conditions().names())
+    for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
+  for (const auto& wall : sim.velocity_conditions().walls())
+    columns.push_back(fmt::format("wall_{}_position", wall.name()));
+  return columns;
+}
+
 /// Output schedule as integer counters so that output times do not drift with round-off.
 struct Schedule {
   double interval = 0.0;
@@ -56,6 +69,9 @@ class Runner {
     sim_.particles() = data.particles;
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
+    auto& walls = sim_.velocity_conditions().walls();
+    for (std::size_t w = 0; w < walls.size(); ++w)
+      walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
     snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
     history_.done = static_cast<long long>(data.scalars.at("history_done"));
@@ -86,6 +102,7 @@ class Runner {
         fail(f);
       }
       last_dt_ = dt;
+      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
       const double t = sim_.time();
       wrote_history = wrote_snapshot = false;
       if (history_.due(t)) {
@@ -132,11 +149,14 @@ class Runner {
   void write_history_row() {
     const Totals t = sim_.totals();
     const double total = t.kinetic_energy + t.strain_energy;
-    history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_,
-                            {t.kinetic_energy, t.strain_energy, sim_.external_work(), total,
-                             total - initial_energy_ - sim_.external_work(),
-                             sim_.dissipated_energy(), t.momentum[0],
-                             t.momentum[1], t.momentum[2]});
+    std::vector<double> row{t.kinetic_energy, t.strain_energy, sim_.external_work(), total,
+                            total - initial_energy_ - sim_.external_work(),
+                            sim_.dissipated_energy(), t.momentum[0],
+                            t.momentum[1], t.momentum[2]};
+    for (const auto& r : sim_.velocity_conditions().reactions())
+      for (int a = 0; a < D; ++a) row.push_back(r[a]);
+    for (const auto& wall : sim_.velocity_conditions().walls()) row.push_back(wall.position());
+    history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_, row);
     ++rows_since_flush_;
     if (rows_since_flush_ >= 20) {
       history_writer_.flush();
@@ -167,6 +187,8 @@ class Runner {
                     {"history_done", static_cast<double>(history_.done)},
                     {"checkpoints_done", static_cast<double>(checkpoint_.done)},
                     {"checkpoint_index", static_cast<double>(checkpoint_index_ + 1)}};
+    const auto& walls = sim_.velocity_conditions().walls();
+    for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
@@ -225,7 +247,7 @@ class Runner {
   Simulation<D> sim_;
   std::filesystem::path dir_;
   Schedule history_, snapshot_, checkpoint_;
-  HistoryWriter history_writer_{dir_ / "history.csv", history_columns};
+  HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
   double initial_energy_ = 0.0;
   double last_dt_ = 0.0;
