@@ -1,6 +1,5 @@
 #include "cairn/bc/traction.hpp"
 
-#include <array>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -23,12 +22,6 @@ ParticleDomain particle_domain_of(const std::string& shape_family) {
 }
 
 namespace {
-
-constexpr int n_gauss = 3;
-const std::array<double, n_gauss> gauss_x{-0.7745966692414834, 0.0, 0.7745966692414834};
-const std::array<double, n_gauss> gauss_w{5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-
-constexpr int points_per_face(int D) { return D == 1 ? 1 : D == 2 ? n_gauss : n_gauss * n_gauss; }
 
 /// Lattice site of a particle: bodies are filled on a lattice of spacing l_p0 from the grid origin.
 template <int D>
@@ -98,80 +91,57 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
     loads_.push_back(std::move(load));
   }
 
-  const std::size_t n_points = faces_.size() * points_per_face(D);
-  points_.resize(n_points);
-  for (std::size_t q = 0; q < n_points; ++q) {
-    points_.size0[q] = Vec<D>::Zero();  // zero-size proxies: S_pi = N_i(x_q)
+  // One proxy particle per face: the particle's extent along the face, none along the normal.
+  points_.resize(faces_.size());
+  for (std::size_t q = 0; q < faces_.size(); ++q) {
+    const Face& f = faces_[q];
+    points_.size0[q] = particles.size0[f.particle];
+    points_.size0[q][f.axis] = 0.0;
     points_.deformation_gradient[q] = Mat3::Identity();
-    points_.position[q] = Vec<D>::Zero();
+    points_.position[q] = particles.position[f.particle];
   }
-  point_force_.assign(n_points, Vec<D>::Zero());
+  point_force_.assign(faces_.size(), Vec<D>::Zero());
 }
 
 template <int D>
 void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
                               double t, std::vector<Vec<D>>& force) {
   if (loads_.empty()) return;
-  constexpr int n_q = points_per_face(D);
-  std::size_t q = 0;
-  for (const Face& f : faces_) {
-    const auto p = static_cast<std::size_t>(f.particle);
-    // Half-edge matrix R of the particle domain: columns are the half edges (seed 000 Sec. 2.1).
-    Eigen::Matrix<double, D, D> R = (0.5 * particles.size0[p]).asDiagonal();
-    if (domain_ == ParticleDomain::convected) {
-      R = particles.deformation_gradient[p].template topLeftCorner<D, D>() * R;
-    } else if (domain_ == ParticleDomain::stretched) {
-      for (int a = 0; a < D; ++a) R(a, a) *= std::abs(particles.deformation_gradient[p](a, a));
-    }
-    const Vec<D> centre = particles.position[p] + static_cast<double>(f.sign) * R.col(f.axis);
-    // Tangent half edges and the face area.
-    std::array<Vec<D>, 2> tangent{Vec<D>::Zero(), Vec<D>::Zero()};
-    int n_t = 0;
-    for (int b = 0; b < D; ++b)
-      if (b != f.axis) tangent[n_t++] = R.col(b);
-    double area = thickness_;
-    if constexpr (D == 2) {
-      area = 2.0 * tangent[0].norm() * thickness_;
-    } else if constexpr (D == 3) {
-      area = (2.0 * tangent[0]).cross(2.0 * tangent[1]).norm();
-    }
-    (void)n_t;
-    const Vec<D>& T = loads_[f.load].traction;  // times the load's factor of this step, below
-    for (int g = 0; g < n_q; ++g, ++q) {
-      Vec<D> x = centre;
-      double w = 1.0;
-      if constexpr (D >= 2) {
-        x += gauss_x[g % n_gauss] * tangent[0];
-        w *= 0.5 * gauss_w[g % n_gauss];
-      }
-      if constexpr (D == 3) {
-        x += gauss_x[g / n_gauss] * tangent[1];
-        w *= 0.5 * gauss_w[g / n_gauss];
-      }
-      points_.position[q] = x;
-      point_force_[q] = (w * area) * T;
-    }
-  }
-  // The factor of each load at time t (faces of one load are contiguous in faces_).
   for (auto& load : loads_) load.total.setZero();
-  q = 0;
   double factor = 0.0;
   std::int32_t factor_of = -1;
-  for (const Face& f : faces_) {
-    if (f.load != factor_of) {
+  for (std::size_t q = 0; q < faces_.size(); ++q) {
+    const Face& f = faces_[q];
+    if (f.load != factor_of) {  // faces of one load are contiguous in faces_
       factor_of = f.load;
       factor = loads_[f.load].factor(t);
     }
-    for (int g = 0; g < n_q; ++g, ++q) {
-      point_force_[q] *= factor;
-      loads_[f.load].total += point_force_[q];
+    const auto p = static_cast<std::size_t>(f.particle);
+    const Mat3& F = particles.deformation_gradient[p];
+    // Half-edge matrix R of the particle domain: its columns are the half edges.
+    Eigen::Matrix<double, D, D> R = (0.5 * particles.size0[p]).asDiagonal();
+    if (domain_ == ParticleDomain::convected) {
+      R = F.template topLeftCorner<D, D>() * R;
+    } else if (domain_ == ParticleDomain::stretched) {
+      for (int a = 0; a < D; ++a) R(a, a) *= std::abs(F(a, a));
     }
+    // Face area: the face spans the half edges R e_b, b != axis.
+    double area = thickness_;
+    if constexpr (D == 2) {
+      area = 2.0 * R.col(1 - f.axis).norm() * thickness_;
+    } else if constexpr (D == 3) {
+      area = (2.0 * R.col((f.axis + 1) % 3)).cross(2.0 * R.col((f.axis + 2) % 3)).norm();
+    }
+    points_.position[q] = particles.position[p] + static_cast<double>(f.sign) * R.col(f.axis);
+    points_.deformation_gradient[q] = F;
+    point_force_[q] = (factor * area) * loads_[f.load].traction;
+    loads_[f.load].total += point_force_[q];
   }
 
   try {
     shape.build(grid, points_, cache_);
   } catch (const SimulationFailure& e) {
-    const auto face = static_cast<std::size_t>(e.particle()) / n_q;
+    const auto face = static_cast<std::size_t>(e.particle());
     const std::int32_t p = face < faces_.size() ? faces_[face].particle : -1;
     throw SimulationFailure(p, "position",
                             "particle " + std::to_string(p) +

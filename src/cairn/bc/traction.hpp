@@ -16,13 +16,22 @@
 //   undeformed (every other family): the initial box l_p0 translated to x_p.
 // The area A_s is that of the face (times the thickness in 2D, the cross-section in 1D).
 //
-// Integral. int_{A_s} N_i dS is evaluated by 3-point Gauss-Legendre rules along each face
-// direction. N_i at a Gauss point is read from the shape family itself, by building its stencil
-// for zero-size proxy particles placed at the Gauss points: with a vanishing particle domain
-// every family's S_pi reduces to its grid function N_i(x) (GIMP convolutions of width 0, CPDI
-// domains collapsed to one corner, B-splines and open-knot splines as they are). The proxies'
-// gradients are not used. Exception: uGIMP with a fixed method.smoothing_length keeps that width,
-// so its tractions are spread with the smoothed functions.
+// Integral. int_{A_s} N_i dS is evaluated the way the shape family evaluates its own particle
+// integrals, by building the family's stencil for one proxy particle per face: the face itself,
+// a particle domain centred on the face with the particle's extent along the face, zero extent
+// along its normal, and the particle's F. So S_pi of the proxy is the family's approximation of
+// (1/A_s) int_{A_s} N_i dS: the exact face average for the GIMP families, the CPDI average of N_i
+// over the corners of the deformed face for cpdi/b2cpdi (seed 000 Sec. 2.1 bracketed form, "CPDI
+// style" of Sec. 2.4), and N_i at the face centre for the point families (linear, B-splines).
+// The proxies' gradients are not used (CPDI leaves them undefined for a flat domain).
+//
+// Why not a finer quadrature for the point families: their lumped masses m_i = sum_p M_p N_i(x_p)
+// sample N_i at the particles, one point per particle. Integrating the traction more exactly
+// along the face than the mass is sampled gives the low-mass nodes just outside the body's edges
+// (the corners of a loaded end) more force per unit mass than the body has; the grid
+// accelerations then vary along the face and leave a checkerboard residual stress at the corners
+// once the load is gone (verification/traction_pulse, README). Sampling the face like the mass
+// keeps f_i / m_i uniform along the face.
 //
 // The traction vector is fixed in space (it does not turn with the face) and is evaluated at the
 // middle of the step, t + dt/2, so that the impulse of a step is second-order accurate.
@@ -86,8 +95,8 @@ class Tractions {
   std::vector<Load> loads_;
   ParticleDomain domain_ = ParticleDomain::undeformed;
   double thickness_ = 1.0;
-  Particles<D> points_;              ///< zero-size proxies at the Gauss points of every face
-  std::vector<Vec<D>> point_force_;  ///< T w A of each Gauss point
+  Particles<D> points_;              ///< one proxy particle per face: the face itself
+  std::vector<Vec<D>> point_force_;  ///< T(t) A_s of each face
   TransferCache<D> cache_;           ///< the family's stencils of the proxies
 };
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
@@ -148,6 +149,14 @@ struct WallConfig {
   SourceLocation where;
 };
 
+/// Heat conduction (thermal/conduction.hpp). Faces: index 2*axis + side.
+enum class ThermalFace : std::uint8_t { adiabatic, temperature, flux };
+struct ThermalConfig {
+  bool conduction = false;
+  std::array<ThermalFace, 6> face{};  ///< adiabatic by default
+  std::array<double, 6> value{};      ///< fixed temperature, or heat flux per area into the body
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -172,6 +181,7 @@ struct Config {
   std::vector<VelocityConditionConfig> velocity_conditions;///< [[velocity]]
   std::vector<WallConfig> walls;                           ///< [[wall]]
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
+  ThermalConfig thermal;
   OutputConfig output;
 };
 

@@ -354,6 +354,7 @@ class Loader {
   BodyShapeConfig read_shape(TableReader& body);
   void read_boundary(const toml::table& root, Config& cfg);
   void read_body_force(const toml::table& root, Config& cfg);
+  void read_thermal(const toml::table& root, Config& cfg);
   void read_tractions(const toml::table& root, Config& cfg);
   void read_velocity_conditions(const toml::table& root, Config& cfg);
   void read_walls(const toml::table& root, Config& cfg);
@@ -839,6 +840,15 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.stress_update = r.string("stress_update");
   m.smoothing_length = r.real("smoothing_length");
   m.cpdi_max_span = r.real("cpdi_max_span");
+  if (m.shape == "ugimp" && !cfg.grid.cell_size.empty()) {
+    // uGIMP reaches l/2 + h beyond a particle; two ghost layers hold that for l <= 2h.
+    const double h_min = *std::min_element(cfg.grid.cell_size.begin(), cfg.grid.cell_size.end());
+    if (m.smoothing_length > 2.0 * h_min * (1.0 + 1e-12))
+      r.fail("smoothing_length", r.given("smoothing_length"),
+             fmt::format("a uGIMP smoothing length of at most twice the smallest cell size ({})",
+                         real_text(2.0 * h_min)),
+             real_text(m.smoothing_length));
+  }
   m.beta = r.real("beta");
   m.blend_position = r.string("blend_position");
   m.grid_damping = r.real("grid_damping");
@@ -892,6 +902,8 @@ void Loader::read_materials(const toml::table& root, Config& cfg) {
                toml_string(m.name));
     m.model = model;
     m.numbers["density"] = r.real("density");
+    m.numbers["conductivity"] = r.real("conductivity");
+    m.numbers["heat_capacity"] = r.real("heat_capacity");
     m.where = {file_, line_of(t)};
 
     const auto info = material_model_info().find(model);
@@ -1079,6 +1091,26 @@ void Loader::read_boundary(const toml::table& root, Config& cfg) {
                          face_names[2 * a + 1]),
              text(2 * a) + ", " + text(2 * a + 1));
     }
+  }
+}
+
+void Loader::read_thermal(const toml::table& root, Config& cfg) {
+  TableReader r(*this, section(root, "thermal"), {"thermal"}, copy_section("thermal"), "[thermal]");
+  r.reject_unknown_keys();
+  cfg.thermal.conduction = r.boolean("conduction");
+  for (int f = 0; f < 6; ++f) {
+    const std::string face = face_names[f];
+    if (f >= 2 * dim_) {
+      for (const std::string& key : {face, face + "_value"})
+        if (r.present(key))
+          r.fail(key, r.given(key), fmt::format("a face of the {}D grid", dim_), key);
+      continue;
+    }
+    const std::string c = r.string(face);
+    cfg.thermal.face[f] = c == "temperature" ? ThermalFace::temperature
+                          : c == "flux"      ? ThermalFace::flux
+                                             : ThermalFace::adiabatic;
+    cfg.thermal.value[f] = r.real(face + "_value");
   }
 }
 
@@ -1298,6 +1330,7 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   read_bodies(root, cfg);
   read_boundary(root, cfg);
   read_body_force(root, cfg);
+  read_thermal(root, cfg);
   read_tractions(root, cfg);
   read_velocity_conditions(root, cfg);
   read_walls(root, cfg);
@@ -1392,6 +1425,8 @@ std::string config_to_toml(const Config& c) {
     line("name", toml_string(mat.name));
     line("model", toml_string(mat.model));
     line("density", real_text(mat.number("density")));
+    line("conductivity", real_text(mat.number("conductivity")));
+    line("heat_capacity", real_text(mat.number("heat_capacity")));
     auto info = material_model_info().find(mat.model);
     if (info == material_model_info().end()) continue;
     for (const auto& d : info->second.keys) {
@@ -1422,6 +1457,16 @@ std::string config_to_toml(const Config& c) {
     line(face_names[f], toml_string(face_condition_names[static_cast<int>(c.boundary.face[f])]));
   line("acceleration", toml_string(c.boundary.acceleration == BoundaryAcceleration::zero ? "zero"
                                                                                   : "velocity_change"));
+
+  o += "\n[thermal]\n";
+  line("conduction", boolean(c.thermal.conduction));
+  for (int f = 0; f < 2 * s.dimension && f < 6; ++f) {
+    const ThermalFace tf = c.thermal.face[f];
+    line(face_names[f], toml_string(tf == ThermalFace::temperature ? "temperature"
+                                    : tf == ThermalFace::flux      ? "flux"
+                                                                   : "adiabatic"));
+    line(std::string(face_names[f]) + "_value", real_text(c.thermal.value[f]));
+  }
 
   if (!c.body_force.expression.empty()) {
     o += "\n[body_force]\n";

@@ -131,7 +131,7 @@ std::vector<KeyDecl> make_declarations() {
                 .choices(stress_update_names));
   k.push_back(Key("method", "smoothing_length", T::real,
                  "uGIMP smoothing length l (full width of the particle function); 0 = the "
-                 "initial particle size.")
+                 "initial particle size. At most twice the smallest cell size.")
                 .by_default("0.0")
                 .min(0.0));
   k.push_back(Key("method", "cpdi_max_span", T::real,
@@ -184,6 +184,14 @@ std::vector<KeyDecl> make_declarations() {
                  "Reference mass density rho_0.")
                 .required()
                 .min(above_zero));
+  k.push_back(Key("material", "conductivity", T::real,
+                 "Thermal conductivity k (used when [thermal] conduction = true).")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("material", "heat_capacity", T::real,
+                 "Heat capacity per unit mass c_p (conduction; heating by plastic and viscous work).")
+                .by_default("0.0")
+                .min(0.0));
 
   // [[body]]
   k.push_back(Key("body", "name", T::string,
@@ -267,6 +275,23 @@ std::vector<KeyDecl> make_declarations() {
                  "velocity to the held one).")
                 .by_default("\"zero\"")
                 .choices(boundary_acceleration_names));
+
+  // [thermal]
+  k.push_back(Key("thermal", "conduction", T::boolean,
+                 "Explicit heat conduction on the grid, coupled with particle temperatures; its "
+                 "stability limit h^2 / (2 D kappa) joins the time step (docs/thermal.md).")
+                .by_default("false"));
+  for (int i = 0; i < 6; ++i) {
+    k.push_back(Key("thermal", faces[i], T::string,
+                   fmt::format("Thermal condition on the {} face: adiabatic, temperature (held at "
+                               "{}_value) or flux ({}_value per unit area into the body).",
+                               faces[i], faces[i], faces[i]))
+                  .by_default("\"adiabatic\"")
+                  .choices([] { return std::vector<std::string>{"adiabatic", "temperature", "flux"}; }));
+    k.push_back(Key("thermal", std::string(faces[i]) + "_value", T::real,
+                   fmt::format("Temperature or heat flux of the {} face.", faces[i]))
+                  .by_default("0.0"));
+  }
 
   // [body_force]
   k.push_back(Key("body_force", "expression", T::expression_array,
@@ -519,6 +544,13 @@ const std::vector<SectionDoc>& section_docs() {
        "x_min = \"fixed\"\n"
        "x_max = \"free\"\n"
        "y_min = \"symmetry\"\n"},
+      {"thermal", "[thermal]",
+       "Heat conduction on the grid and thermal conditions on the grid faces (docs/thermal.md). "
+       "Materials give conductivity and heat_capacity.",
+       "[thermal]\n"
+       "conduction = true\n"
+       "x_min = \"temperature\"\n"
+       "x_min_value = 400.0\n"},
       {"body_force", "[body_force]",
        "A body force per unit mass (e.g. gravity), applied to every particle.",
        "[body_force]\n"
@@ -767,7 +799,7 @@ std::vector<const KeyDecl*> section_keys(std::string_view section) {
 const std::vector<std::string>& section_names() {
   static const std::vector<std::string> names{"simulation", "grid",     "method",
                                               "constants",  "material", "body",
-                                              "boundary",   "body_force", "traction",
+                                              "boundary",   "thermal",    "body_force", "traction",
                                               "velocity",   "wall",       "output"};
   return names;
 }

@@ -203,7 +203,6 @@ MaterialModelInfo info() {
       key("hardening_strain", "power-law reference strain eps0", "1.0"),
       key("av_a1", "artificial viscosity A1 (seed 004 Eq. 52)", "0.0"),
       key("av_a2", "artificial viscosity A2 (seed 004 Eq. 52)", "0.0"),
-      key("heat_capacity", "heat capacity c_v per unit mass; 0 = no heating by work", "0.0"),
       key("initial_temperature", "initial temperature of the particles", "298.15"),
   };
   KeyDecl h;

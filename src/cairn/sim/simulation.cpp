@@ -55,6 +55,16 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   particles_.n_state_per_particle = n_state;
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   nodes_.resize(grid_.n_nodes());
+  for (const auto& m : materials_) material_density_.push_back(m->density());
+  if (config_.thermal.conduction) {
+    std::vector<double> k, cp;
+    for (const auto& mc : config_.materials) {
+      k.push_back(mc.has("conductivity") ? mc.number("conductivity") : 0.0);
+      cp.push_back(mc.has("heat_capacity") ? mc.number("heat_capacity") : 0.0);
+    }
+    conduction_ = std::make_unique<Conduction<D>>(config_.thermal, grid_, k, cp,
+                                                  config_.simulation.thickness);
+  }
   grid_term_.assign(grid_.n_nodes(), Vec<D>::Zero());
   grid_proj_.assign(grid_.n_nodes(), Vec<D>::Zero());
   particle_vec_.assign(particles_.n(), Vec<D>::Zero());
@@ -112,7 +122,10 @@ template <int D>
 double Simulation<D>::next_dt() const {
   const auto& s = config_.simulation;
   double dt = s.fixed_dt;
-  if (dt <= 0.0) dt = s.cfl * grid_.min_cell_size() / max_signal_speed();  // seed 001 Eq. 34
+  if (dt <= 0.0) {
+    dt = s.cfl * grid_.min_cell_size() / max_signal_speed();  // seed 001 Eq. 34
+    if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
+  }
   const double remaining = s.end_time - time_;
   if (remaining > 0.0 && dt > remaining) dt = remaining;
   return dt;
@@ -198,6 +211,7 @@ void Simulation<D>::step(double dt) {
       break;
   }
   lap(5);
+  if (conduction_) conduction_->step(cache_, particles_, dt);
   velocity_conditions_.finish_step();
   time_ += dt;
   ++step_;

@@ -18,6 +18,7 @@
 #include "cairn/particles/particles.hpp"
 #include "cairn/schemes/scheme.hpp"
 #include "cairn/shapes/shape_family.hpp"
+#include "cairn/thermal/conduction.hpp"
 #include "cairn/transfer/cache.hpp"
 
 namespace cairn {
@@ -119,7 +120,9 @@ class Simulation {
   std::vector<std::unique_ptr<Material>> materials_;
   std::unique_ptr<ShapeFamily<D>> shape_;
   std::unique_ptr<UpdateScheme<D>> scheme_;
-  std::unique_ptr<UpdateScheme<D>> flip_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
+  std::unique_ptr<UpdateScheme<D>> flip_;
+  std::unique_ptr<Conduction<D>> conduction_;  ///< [thermal] conduction = true
+  std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
