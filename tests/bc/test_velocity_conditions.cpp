@@ -94,10 +94,11 @@ TEST(VelocityConditions, LaterConditionWinsAndTheRunSaysSoOnce) {
   EXPECT_TRUE(a_then_b);
   sim.step(1e-4);
   EXPECT_TRUE(sim.take_notes().empty());  // once per pair
-  // The last table wins along its direction: c holds v_y = 0 after b set v . (1,1)/sqrt2 = 3.
+  // In order: fixed (0, 0); a: v_x = 1; b: v . (1, 1)/sqrt2 = 3 gives (1/2 + 3/sqrt2, 3/sqrt2 - 1/2);
+  // c, the last, holds v_y = 0 and leaves v_x.
   const auto i = sim.velocity_conditions().set_nodes(0)[0];
   EXPECT_NEAR(sim.nodes().velocity_new[i][1], 0.0, 1e-15);
-  EXPECT_NEAR(sim.nodes().velocity_new[i][0], 3.0 * std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(sim.nodes().velocity_new[i][0], 0.5 + 3.0 / std::sqrt(2.0), 1e-12);
 }
 
 TEST(MovingWall, ControlsInsideNodesWithinDepthAndOutsideNodesWithMass) {
@@ -127,21 +128,24 @@ TEST(MovingWall, ControlsInsideNodesWithinDepthAndOutsideNodesWithMass) {
 }
 
 TEST(MovingWall, MovesWithItsVelocityAndEstimatesTheGradient) {
-  // A 1D bar with V = rate X and walls moving with the ends: the exact Eulerian field is linear,
-  // so Eq. 4 recovers its gradient from nodes 1 and 2 once the rows are interior.
+  // A 1D bar with V = rate X: with depth 2, nodes 1 and 2 of Eq. 4 (3 and 2 cells deep) see a full
+  // stencil of particles, so m^-1 p there is the exact linear field and Eq. 4 returns its slope.
   const std::string walls =
-      "[[wall]]\nname = \"right\"\naxis = \"x\"\ninside = \"below\"\nposition = 1.0\nvelocity = \"rate + 0.5*t\"\n"
-      "gradient = \"estimate\"\ndepth = 1.5\n"
+      "[[wall]]\nname = \"right\"\naxis = \"x\"\ninside = \"below\"\nposition = 1.0\nvelocity = \"rate*(1 + t)\"\n"
+      "gradient = \"estimate\"\ndepth = 2.0\n"
       "[[wall]]\nname = \"left\"\naxis = \"x\"\ninside = \"above\"\nposition = -1.0\nvelocity = \"-rate\"\n"
-      "gradient = \"estimate\"\ndepth = 1.5\n";
+      "gradient = \"estimate\"\ndepth = 2.0\n";
   Simulation<1> sim(load_config_string(bar(walls, 1, "shape = \"bspline2\"\nupdate = \"fmpm\"\norder = 2"), "b.toml"));
   const double dt = 1e-3;
-  for (int s = 0; s < 200; ++s) sim.step(dt);
+  sim.step(dt);
   const auto& w = sim.velocity_conditions().walls();
+  EXPECT_NEAR(w[1].gradient(), 0.01, 1e-14);  // the exact field at t = 0: V = rate X
+  EXPECT_NEAR(w[0].gradient(), 0.01, 1e-14);  // v_b = rate at t = 0
+  for (int s = 1; s < 200; ++s) sim.step(dt);
   const double T = 200 * dt;
-  EXPECT_NEAR(w[0].position(), 1.0 + 0.01 * T + 0.25 * T * T, 1e-12);  // trapezoid is exact here
+  EXPECT_NEAR(w[0].position(), 1.0 + 0.01 * (T + 0.5 * T * T), 1e-12);  // trapezoid is exact here
   EXPECT_NEAR(w[1].position(), -1.0 - 0.01 * T, 1e-12);
-  EXPECT_NEAR(w[1].gradient(), 0.01, 2e-4);
+  EXPECT_NEAR(w[1].gradient(), 0.01 / (1.0 + 0.01 * T), 2e-4);
 }
 
 TEST(MovingWall, FullMassMethodsImposeTheConditionsAsSeed000Eq3Says) {
@@ -225,7 +229,7 @@ TEST(LoadInput, ErrorsNameTheKey) {
             std::string::npos);
   EXPECT_NE(error_of("[[wall]]\nname = \"w\"\naxis = \"x\"\ninside = \"below\"\nposition = 0.0\n"
                      "[[velocity]]\nname = \"w\"\nface = \"x_min\"\ndirection = [1.0, 0.0]\n")
-                .find("velocity[0].name"),
+                .find("wall[0].name"),
             std::string::npos);
 }
 

@@ -188,7 +188,8 @@ TEST(InputErrors, SetOfUnknownKey) {
             "(did you mean 'order'?); found an undeclared key");
   EXPECT_EQ(message(error_of(base, {"materail[0].density=1"})),
             "--set materail[0].density=1: key 'materail': expected a section, one of simulation, grid, "
-            "method, constants, material, body, boundary, body_force, output (did you mean "
+            "method, constants, material, body, boundary, thermal, body_force, traction, velocity, wall, "
+            "output (did you mean "
             "'material'?); found an undeclared key");
   // The model decides the keys of a [[material]].
   EXPECT_EQ(message(error_of(base, {"material.0.form=\"ln_j\""})).rfind(
@@ -423,7 +424,8 @@ TEST(Input, DefaultsAreFilled) {
   EXPECT_TRUE(c.constants.empty());
   ASSERT_EQ(c.materials.size(), 1u);
   EXPECT_EQ(c.materials[0].numbers,
-            (std::map<std::string, double>{{"density", 1500.0}, {"youngs_modulus", 1.0e6}, {"poissons_ratio", 0.3}}));
+            (std::map<std::string, double>{{"density", 1500.0}, {"youngs_modulus", 1.0e6}, {"poissons_ratio", 0.3},
+                                          {"conductivity", 0.0}, {"heat_capacity", 0.0}}));
   EXPECT_EQ(c.materials[0].where.str(), "examples/case.toml:16");
   ASSERT_EQ(c.bodies.size(), 1u);
   const BodyConfig& b = c.bodies[0];

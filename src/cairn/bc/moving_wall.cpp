@@ -110,7 +110,7 @@ void MovingWall<D>::prepare(const Grid<D>& grid, const NodeField<D>& nodes, doub
     for (long long line = 0; line < n_lines; ++line) {
       const std::int32_t i = line_node(line, j);
       if (i < 0) continue;
-      if (outside && !(nodes.mass[i] > small_mass)) continue;
+      if (!(nodes.mass[i] > small_mass)) continue;  // no material at the node: nothing to control
       out.push_back({i, owner, e, start, end});
     }
   }

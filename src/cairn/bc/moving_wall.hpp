@@ -3,7 +3,8 @@
 // The wall has a position x_wall(t), a velocity v_b(t) along its axis and a gradient grad v_b.
 // Each step it controls the axis component of the grid velocity on
 //   - every node inside the material within depth d (cells) of the wall, 0 <= depth <= d h, and
-//   - every node outside the wall that carries mass,
+//   - every node outside the wall that carries mass
+// (nodes without mass, e.g. beside the body along the wall, carry no velocity and are skipped),
 // setting v_i = v_b + grad v_b (x_i - x_wall). The gradient is given (an expression in t), zero,
 // or estimated by Eq. 4 from the velocities m^-1 p extrapolated to nodes 1 and 2 of Fig. 1B (the
 // last uncontrolled and the first controlled node inside the material, or the two shallowest

@@ -39,13 +39,22 @@ struct Domain {
   static constexpr int n_corners = 1 << D;
   Vec<D> xi;                               ///< particle position in cell units
   Eigen::Matrix<double, D, D> Rc;          ///< half edges in cell units (columns)
-  Vec<D> extent;                           ///< half of the corner spread per axis (cells)
+  std::array<Vec<D>, n_corners> corner;    ///< corner positions in cell units
   IVec<D> lo, dims;                        ///< node box: first node and nodes per axis
   bool fallback = false;                   ///< GIMP of the undeformed box instead
   Vec<D> half;                             ///< fallback: box half-width in cells
 };
 
-/// Corner spread, guard decision and node box; cheap enough to run twice per step.
+/// Sign vector s_c of corner c: bit a of c set means +1 along axis a.
+template <int D>
+Vec<D> corner_sign(int c) {
+  Vec<D> s;
+  for (int a = 0; a < D; ++a) s[a] = (c >> a) & 1 ? 1.0 : -1.0;
+  return s;
+}
+
+/// Corners, guard decision and node box; cheap enough to run twice per step. The box is taken
+/// from the corners as computed here, so both passes agree to the last bit.
 template <int D, class Fn>
 Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_t p, double max_span) {
   Domain<D> dom;
@@ -54,10 +63,10 @@ Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_
   const Vec<D> half_size = 0.5 * parts.size0[p];
   const auto F = parts.deformation_gradient[p].template topLeftCorner<D, D>();
   dom.Rc = inv_h.asDiagonal() * F * half_size.asDiagonal();
-  dom.extent = dom.Rc.cwiseAbs().rowwise().sum();
+  const Vec<D> spread = 2.0 * dom.Rc.cwiseAbs().rowwise().sum();
   const double det = F.determinant();
   bool ok = std::isfinite(det) && det > 0.0;
-  for (int a = 0; a < D && ok; ++a) ok = 2.0 * dom.extent[a] <= max_span;
+  for (int a = 0; a < D && ok; ++a) ok = spread[a] <= max_span;
   if (!ok) {
     dom.fallback = true;
     dom.half = half_size.cwiseProduct(inv_h);
@@ -67,11 +76,18 @@ Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_
     }
     return dom;
   }
-  // first_node is monotone, so the extreme corners bound the box.
-  for (int a = 0; a < D; ++a) {
-    dom.lo[a] = Fn::first_node(dom.xi[a] - dom.extent[a]);
-    dom.dims[a] = Fn::first_node(dom.xi[a] + dom.extent[a]) + Fn::n_nodes - dom.lo[a];
+  IVec<D> hi;
+  dom.lo.setConstant(INT_MAX);
+  hi.setConstant(INT_MIN);
+  for (int c = 0; c < Domain<D>::n_corners; ++c) {
+    dom.corner[c] = dom.xi + dom.Rc * corner_sign<D>(c);
+    for (int a = 0; a < D; ++a) {
+      const int f = Fn::first_node(dom.corner[c][a]);
+      dom.lo[a] = std::min(dom.lo[a], f);
+      hi[a] = std::max(hi[a], f);
+    }
   }
+  dom.dims = hi - dom.lo + IVec<D>::Constant(Fn::n_nodes);
   return dom;
 }
 
@@ -154,13 +170,11 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
         const MatD RinvT =
             (h.asDiagonal() * dom.Rc).inverse().transpose() / static_cast<double>(n_corners);
         for (int c = 0; c < n_corners; ++c) {
-          Vec<D> sgn;
-          for (int a = 0; a < D; ++a) sgn[a] = (c >> a) & 1 ? 1.0 : -1.0;
-          const Vec<D> corner = dom.xi + dom.Rc * sgn;
-          const Vec<D> g = RinvT * sgn;
+          const Vec<D> g = RinvT * cpdi_detail::corner_sign<D>(c);
           std::array<std::array<double, nn>, D> v;
           int base = 0;
-          for (int a = 0; a < D; ++a) base += (Fn::weights(corner[a], v[a].data()) - dom.lo[a]) * stride[a];
+          for (int a = 0; a < D; ++a)
+            base += (Fn::weights(dom.corner[c][a], v[a].data()) - dom.lo[a]) * stride[a];
           if constexpr (D == 1) {
             for (int i = 0; i < nn; ++i) {
               S[base + i] += v[0][i];
