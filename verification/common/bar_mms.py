@@ -1,7 +1,8 @@
-"""The 1D periodic bar with a manufactured solution (seed 003 Sec. 5.2, Eq. 47-50; Sec. 6.2, Fig. 10),
+"""The 1D bar with a manufactured solution (seed 003 Sec. 5.2, Eq. 47-50; Sec. 6.2, Fig. 10),
 shared by verification/bar_1d_mms and verification/bar_1d_mms_order_4ppc.
 
-u(X, t) = A sin(2 pi X) cos(C pi t) on the unit interval, driven by the body force of Eq. 49,
+u(X, t) = A sin(2 pi X) cos(C pi t) on the unit interval (periodic, or with fixed faces: u = 0 at
+X = 0 and 1 for all t), driven by the body force of Eq. 49,
 neo-Hookean with nu = 0 (sigma = E/2 (F - 1/F), Eq. 50), run to T = 1/C with dt = 4e-6.
 Error per particle (Eq. 54): e_p = x_p(T) - X_p - u(X_p, T); max and RMS over particles.
 
@@ -39,9 +40,21 @@ class Series:
     colour: str = "C0"
 
     @property
+    def periodic(self):
+        return self.boundary == PERIODIC
+
+    @property
+    def faces(self):
+        """'periodic', or the face conditions, e.g. 'fixed'."""
+        if self.periodic:
+            return "periodic"
+        return "/".join(sorted(set(self.boundary.values())))
+
+    @property
     def title(self):
         extra = "".join(f", {k} = {v}" for k, v in self.method.items())
-        return f"{self.label} ({self.shape}, {self.ppc} ppc{extra}{'' if self.asserted else ', not asserted'})"
+        return (f"{self.label} ({self.shape}, {self.ppc} ppc, {self.faces} faces{extra}"
+                f"{'' if self.asserted else ', not asserted'})")
 
 
 def exact_u(X, t):
@@ -52,7 +65,7 @@ def make_input(series: Series, cells: int, run_dir, header: str = "") -> str:
     u = "A*sin(2*_pi*X)*cos(C*_pi*t)"
     F = "(1 + 2*A*_pi*cos(2*_pi*X)*cos(C*_pi*t))"
     doc = {
-        "simulation": {"title": f"1D periodic bar MMS, {series.shape}, {series.ppc} ppc, {cells} cells",
+        "simulation": {"title": f"1D bar MMS, {series.shape}, {series.ppc} ppc, {series.faces} faces, {cells} cells",
                        "dimension": 1, "mode": "uniaxial", "end_time": T, "dt": DT},
         "constants": {"A": A, "C": C},
         "grid": {"origin": [0.0], "extent": [1.0], "cell_size": 1.0 / cells},
@@ -92,7 +105,7 @@ def run_series(args, series: Series, cells, header: str = ""):
         toml = args.out / f"{name}.toml"
         toml.write_text(make_input(series, n, run_dir, header))
         wall = cc.run_cairn(args, toml, run_dir)
-        t_end, emax, erms, X, e = errors(run_dir, series.boundary == PERIODIC)
+        t_end, emax, erms, X, e = errors(run_dir, series.periodic)
         if abs(t_end - T) > 1e-12:
             raise RuntimeError(f"{name}: last snapshot at t = {t_end}, expected {T}")
         rows.append({"cells": n, "h": 1.0 / n, "max": emax, "rms": erms, "wall": wall, "X": X, "e": e})
@@ -140,22 +153,26 @@ def write_csv(path, results: dict):
                 f.write(f"{label},{r['cells']},{r['h']!r},{r['max']!r},{r['rms']!r},{r['wall']:.2f}\n")
 
 
-def plot_errors(ax, series_list, results, cells, slope_ref=None):
+def plot_errors(ax, series_list, results, cells, slope_ref=None, slope1_ref=None, title=None):
     """Fig. 10 style: max (solid) and RMS (dashed) error against the number of cells."""
     for s in series_list:
         rows = results[s.label]
         n = [r["cells"] for r in rows]
-        ax.loglog(n, [r["max"] for r in rows], "o-", color=s.colour, label=f"{s.label}, max")
-        ax.loglog(n, [r["rms"] for r in rows], "s--", color=s.colour, ms=4, alpha=0.7, label=f"{s.label}, RMS")
+        name = f"{s.shape}, {s.ppc} ppc, {s.faces}"
+        ax.loglog(n, [r["max"] for r in rows], "o-", color=s.colour, label=f"{name}, max")
+        ax.loglog(n, [r["rms"] for r in rows], "s--", color=s.colour, ms=4, alpha=0.7, label=f"{name}, RMS")
+    n = np.array(cells, float)
     if slope_ref:
-        n = np.array(cells, float)
         e0 = results[slope_ref][0]["max"]
         ax.loglog(n, e0 * (n[0] / n) ** 2, "k:", label="slope 2")
+    if slope1_ref:
+        e0 = results[slope1_ref][0]["max"]
+        ax.loglog(n, e0 * (n[0] / n), "k-.", label="slope 1")
     ax.set_xticks(cells)
     ax.set_xticklabels([str(c) for c in cells])
     ax.minorticks_off()
     ax.set_xlabel("grid cells on [0, 1]")
     ax.set_ylabel("position error at T (Eq. 54)")
-    ax.set_title(f"1D periodic bar MMS, A = {A}, dt = {DT:g}, T = 1/C")
+    ax.set_title(title or f"1D bar MMS, A = {A}, dt = {DT:g}, T = 1/C")
     ax.legend(fontsize=7)
     ax.grid(True, which="both", alpha=0.3)

@@ -21,7 +21,8 @@ using Clock = std::chrono::steady_clock;
 
 const std::vector<std::string> history_columns = {
     "kinetic_energy", "strain_energy", "external_work", "total_energy", "energy_error",
-    "dissipated_energy", "momentum_x", "momentum_y", "momentum_z"};
+    "dissipated_energy", "momentum_x", "momentum_y", "momentum_z", "mean_temperature",
+    "max_pressure"};
 
 /// The columns of history.csv: the fixed ones, then per [[velocity]]/[[wall]] its reaction force
 /// reaction_<name>_<axis> (seed 000 Sec. 2.4, summed over its nodes, from the last step), then per
@@ -152,7 +153,7 @@ class Runner {
     std::vector<double> row{t.kinetic_energy, t.strain_energy, sim_.external_work(), total,
                             total - initial_energy_ - sim_.external_work(),
                             sim_.dissipated_energy(), t.momentum[0],
-                            t.momentum[1], t.momentum[2]};
+                            t.momentum[1], t.momentum[2], t.mean_temperature, t.max_pressure};
     for (const auto& r : sim_.velocity_conditions().reactions())
       for (int a = 0; a < D; ++a) row.push_back(r[a]);
     for (const auto& wall : sim_.velocity_conditions().walls()) row.push_back(wall.position());

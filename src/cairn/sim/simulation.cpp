@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "cairn/materials/plane_stress.hpp"
@@ -533,6 +534,13 @@ Totals Simulation<D>::totals() const {
     return Vec3(to3<D>(P.mass[p] * P.velocity[p]));
   });
   t.mass = chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p]; });
+  t.mean_temperature =
+      chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
+  double p_max = -std::numeric_limits<double>::infinity();
+#pragma omp parallel for reduction(max : p_max)
+  for (std::int64_t p = 0; p < n; ++p)
+    p_max = std::max(p_max, -P.kirchhoff_stress[p].trace() / (3.0 * P.deformation_gradient[p].determinant()));
+  t.max_pressure = n > 0 ? p_max : 0.0;
   return t;
 }
 

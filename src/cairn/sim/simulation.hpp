@@ -29,6 +29,8 @@ struct Totals {
   double strain_energy = 0.0;
   Vec3 momentum = Vec3::Zero();
   double mass = 0.0;
+  double mean_temperature = 0.0;  ///< mass-weighted particle temperature
+  double max_pressure = 0.0;      ///< largest particle pressure -tr(sigma)/3
 };
 
 template <int D>
