@@ -506,7 +506,8 @@ const std::vector<SectionDoc>& section_docs() {
        "stress_update = \"usl\"\n"},
       {"constants", "[constants]",
        "A free table of named numbers usable in every expression (body velocity, displacement, "
-       "body force). Names must be identifiers other than x, y, z, X, Y, Z, t, _pi and _e.",
+       "body force, tractions, velocity conditions, walls). Names must be identifiers other than "
+       "x, y, z, X, Y, Z, t, _pi and _e.",
        "[constants]\n"
        "A = 0.05\n"
        "omega = 1.2e3\n"},
