@@ -42,16 +42,11 @@ void MovingWall<D>::prepare(const Grid<D>& grid, const NodeField<D>& nodes, doub
 
   // Nodes 1 and 2 of Eq. 4 along the axis: node 2 is the deepest controlled node inside (or the
   // shallowest inside node when none is controlled), node 1 the next one deeper.
-  int j2 = 0;
-  {
-    // The inside node nearest the wall, then step inwards while still within depth d.
-    int j = static_cast<int>(into > 0 ? std::ceil((x_w - lo) / h - 1e-9) : std::floor((x_w - lo) / h + 1e-9));
-    j2 = j;
-    const int step = into > 0 ? 1 : -1;
-    while (depth_of(j + step) <= depth + tol) j += step;
-    if (depth_of(j) <= depth + tol) j2 = j;
-  }
-  const int j1 = j2 + (into > 0 ? 1 : -1);
+  // Start from the inside node nearest the wall and step inwards while the next one is within d.
+  const int step = into > 0 ? 1 : -1;
+  int j2 = static_cast<int>(into > 0 ? std::ceil((x_w - lo) / h - 1e-9) : std::floor((x_w - lo) / h + 1e-9));
+  while (depth_of(j2 + step) <= depth + tol) j2 += step;
+  const int j1 = j2 + step;
 
   // Transverse lines: odometer over the other axes' stored nodes.
   IVec<D> first = IVec<D>::Zero(), count = IVec<D>::Ones();
