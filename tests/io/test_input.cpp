@@ -189,7 +189,7 @@ TEST(InputErrors, SetOfUnknownKey) {
   EXPECT_EQ(message(error_of(base, {"materail[0].density=1"})),
             "--set materail[0].density=1: key 'materail': expected a section, one of simulation, grid, "
             "method, constants, material, body, boundary, thermal, body_force, traction, velocity, wall, "
-            "output (did you mean "
+            "contact, contact_pair, output (did you mean "
             "'material'?); found an undeclared key");
   // The model decides the keys of a [[material]].
   EXPECT_EQ(message(error_of(base, {"material.0.form=\"ln_j\""})).rfind(
@@ -259,16 +259,16 @@ TEST(InputErrors, UnknownMaterialModel) {
 TEST(InputErrors, BodyShapeOfUnknownKind) {
   EXPECT_EQ(message(error_of(with("{ box = { min", "{ cube = { min"))),
             "case.toml:26: key 'body[0].shape.cube': expected a shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere; found \"cube\"");
+            "ellipse, annulus, polygon, sphere, image; found \"cube\"");
   EXPECT_EQ(message(error_of(with("shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] } }",
                                   "shape = { sphere = { center = [0.03, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape.sphere': expected a shape kind valid in 2D, one of box, "
-            "circle, ellipse, annulus, polygon; found \"sphere\"");
+            "circle, ellipse, annulus, polygon, image; found \"sphere\"");
   EXPECT_EQ(message(error_of(with("shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] } }",
                                   "shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] }, "
                                   "circle = { center = [0.1, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape': expected exactly one shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere; found 2 kinds: box, circle");
+            "ellipse, annulus, polygon, sphere, image; found 2 kinds: box, circle");
 }
 
 TEST(InputErrors, BodyShapeMissingItsParameters) {

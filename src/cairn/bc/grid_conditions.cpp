@@ -45,11 +45,11 @@ GridConditions<D>::GridConditions(const BoundaryConfig& boundary, const Grid<D>&
 
 template <int D>
 void GridConditions<D>::apply(std::vector<Vec<D>>& velocity, const std::vector<double>& mass,
-                              std::vector<Vec<D>>* reaction, double dt) const {
+                              std::vector<Vec<D>>* reaction, double dt, std::int32_t offset) const {
   const auto n_held = static_cast<std::int64_t>(nodes_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < n_held; ++k) {
-    const std::int32_t i = nodes_[k];
+    const std::int32_t i = nodes_[k] + offset;
     for (int a = 0; a < D; ++a) {
       if (!(mask_[k] & (1u << a))) continue;
       // seed 000 Sec. 2.4: a^(b) dt = (v^(b) - v^UL . n) n; the reaction is m a^(b)
@@ -63,14 +63,14 @@ void GridConditions<D>::apply(std::vector<Vec<D>>& velocity, const std::vector<d
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < n_mirrors; ++k) {
     const Mirror& m = mirrors_[k];
-    Vec<D> v = velocity[m.source];
+    Vec<D> v = velocity[m.source + offset];
     for (int a = 0; a < D; ++a)
       if (m.negate & (1u << a)) v[a] = -v[a];
     mirrored_[k] = v;
   }
 #pragma omp parallel for schedule(static)
   for (std::int64_t k = 0; k < n_mirrors; ++k) {
-    const std::int32_t i = mirrors_[k].node;
+    const std::int32_t i = mirrors_[k].node + offset;
     if (reaction) (*reaction)[i] += mass[i] * (mirrored_[k] - velocity[i]) / dt;
     velocity[i] = mirrored_[k];
   }

@@ -37,15 +37,16 @@ class GridConditions {
                  FaceBasis basis = FaceBasis::ghost_nodes);
 
   /// Impose the conditions on one velocity field; if `reaction` is given, add
-  /// m (v_imposed - v_before) / dt to it.
+  /// m (v_imposed - v_before) / dt to it. `offset` shifts every node index (the field of a
+  /// multimaterial run: entries field * n_nodes + node).
   void apply(std::vector<Vec<D>>& velocity, const std::vector<double>& mass,
-             std::vector<Vec<D>>* reaction, double dt) const;
+             std::vector<Vec<D>>* reaction, double dt, std::int32_t offset = 0) const;
 
   /// The step's use: impose on v+ = m^-1 p+ (recording reactions) and, with the default
   /// acceleration option `zero`, also on v = m^-1 p.
-  void apply_step(NodeField<D>& nodes, double dt) const {
-    if (acceleration_ == BoundaryAcceleration::zero) apply(nodes.velocity, nodes.mass, nullptr, dt);
-    apply(nodes.velocity_new, nodes.mass, &nodes.reaction, dt);
+  void apply_step(NodeField<D>& nodes, double dt, std::int32_t offset = 0) const {
+    if (acceleration_ == BoundaryAcceleration::zero) apply(nodes.velocity, nodes.mass, nullptr, dt, offset);
+    apply(nodes.velocity_new, nodes.mass, &nodes.reaction, dt, offset);
   }
 
   [[nodiscard]] bool empty() const { return nodes_.empty() && mirrors_.empty(); }

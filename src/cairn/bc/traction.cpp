@@ -105,7 +105,8 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
 
 template <int D>
 void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
-                              double t, std::vector<Vec<D>>& force) {
+                              double t, std::vector<Vec<D>>& force,
+                              const std::vector<std::int32_t>* field_offset) {
   if (loads_.empty()) return;
   for (auto& load : loads_) load.total.setZero();
   double factor = 0.0;
@@ -150,17 +151,19 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
     const std::size_t begin = k * static_cast<std::size_t>(cache_.stride);
     const std::size_t end = begin + cache_.count[k];
-    for (std::size_t s = begin; s < end; ++s) force[cache_.node[s]] += cache_.weight[s] * point_force_[k];
+    const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
+    for (std::size_t s = begin; s < end; ++s) force[cache_.node[s] + off] += cache_.weight[s] * point_force_[k];
   }
 }
 
 template <int D>
-double Tractions<D>::power(const std::vector<Vec<D>>& v) const {
+double Tractions<D>::power(const std::vector<Vec<D>>& v, const std::vector<std::int32_t>* field_offset) const {
   double w = 0.0;
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
     const std::size_t begin = k * static_cast<std::size_t>(cache_.stride);
     const std::size_t end = begin + cache_.count[k];
-    for (std::size_t s = begin; s < end; ++s) w += cache_.weight[s] * point_force_[k].dot(v[cache_.node[s]]);
+    const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
+    for (std::size_t s = begin; s < end; ++s) w += cache_.weight[s] * point_force_[k].dot(v[cache_.node[s] + off]);
   }
   return w;
 }

@@ -69,11 +69,14 @@ class Tractions {
   /// Number of faces loaded by traction `k`.
   [[nodiscard]] std::size_t n_faces(std::size_t k) const { return loads_[k].n_faces; }
 
-  /// force_i += f_i^(T) at time t for the current particle configuration.
+  /// force_i += f_i^(T) at time t for the current particle configuration. `field_offset`
+  /// (multimaterial mode) gives per particle the shift of its field's node entries.
   void add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
-                  double t, std::vector<Vec<D>>& force);
+                  double t, std::vector<Vec<D>>& force,
+                  const std::vector<std::int32_t>* field_offset = nullptr);
   /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v).
-  [[nodiscard]] double power(const std::vector<Vec<D>>& v) const;
+  [[nodiscard]] double power(const std::vector<Vec<D>>& v,
+                             const std::vector<std::int32_t>* field_offset = nullptr) const;
   /// Total force of traction k at the last add_forces (sum over its faces of T A_s).
   [[nodiscard]] Vec<D> total_force(std::size_t k) const { return loads_[k].total; }
 

@@ -105,18 +105,20 @@ void VelocityConditions<D>::finish_step() {
 }
 
 template <int D>
-void VelocityConditions<D>::apply(std::vector<Vec<D>>& velocity, When when) const {
+void VelocityConditions<D>::apply(std::vector<Vec<D>>& velocity, When when, std::int32_t offset) const {
   for (const auto& e : entries_) {
-    Vec<D>& v = velocity[e.node];
+    Vec<D>& v = velocity[e.node + offset];
     v += ((when == When::start ? e.start : e.end) - v.dot(e.direction)) * e.direction;
   }
 }
 
 template <int D>
-void VelocityConditions<D>::apply_step(NodeField<D>& nodes, double dt, bool constrain_start) {
-  for (auto& r : reactions_) r.setZero();
+void VelocityConditions<D>::apply_step(NodeField<D>& nodes, double dt, bool constrain_start, std::int32_t offset,
+                                       bool reset_reactions) {
+  if (reset_reactions)
+    for (auto& r : reactions_) r.setZero();
   for (const auto& e : entries_) {
-    const std::int32_t i = e.node;
+    const std::int32_t i = e.node + offset;
     const Vec<D>& n = e.direction;
     double shift = 0.0;
     if (constrain_start) {

@@ -60,9 +60,12 @@ class VelocityConditions {
   void finish_step();
 
   /// Impose the start or end values on one velocity field.
-  void apply(std::vector<Vec<D>>& velocity, When when) const;
+  void apply(std::vector<Vec<D>>& velocity, When when, std::int32_t offset = 0) const;
   /// Task 3: the end values on v+ with reactions, and (constrain_start) the start values on v.
-  void apply_step(NodeField<D>& nodes, double dt, bool constrain_start);
+  /// `offset`: the field of a multimaterial run (entries field * n_nodes + node); reactions are
+  /// reset only when `reset_reactions` (the first field), so they sum over the fields.
+  void apply_step(NodeField<D>& nodes, double dt, bool constrain_start, std::int32_t offset = 0,
+                  bool reset_reactions = true);
 
   /// Reaction force of each condition/wall (names() order) in the last apply_step.
   [[nodiscard]] const std::vector<Vec<D>>& reactions() const { return reactions_; }

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,14 +69,26 @@ struct MaterialConfig {
   [[nodiscard]] double number(const std::string& key) const { return numbers.at(key); }
 };
 
+struct GreyImage;  // io/image.hpp
+
 struct BodyShapeConfig {
-  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere
+  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | image
   std::vector<double> min, max;         ///< box
   std::vector<double> center;           ///< circle, ellipse, annulus, sphere
   double radius = 0.0;                  ///< circle, sphere
   std::vector<double> semi_axes;        ///< ellipse (2D) / ellipsoid (3D)
   double inner_radius = 0.0, outer_radius = 0.0;  ///< annulus
   std::vector<std::vector<double>> vertices;      ///< polygon (2D)
+  /// image (2D): PNG file (absolute once loaded; relative = to the input file's directory),
+  /// square pixel edge, physical position of the picture's lower-left corner, and the grey
+  /// levels [level_min, level_max] (0..255) that belong to the body.
+  std::string file;
+  double pixel_size = 0.0;
+  std::vector<double> origin;
+  int level_min = 0, level_max = 255;
+  /// image: the pixels, read once by the loader and shared by bodies naming the same file;
+  /// null when the Config was built in code (bodies.cpp then reads `file`).
+  std::shared_ptr<const GreyImage> image;
 };
 
 struct BodyConfig {
@@ -157,6 +170,33 @@ struct ThermalConfig {
   std::array<double, 6> value{};      ///< fixed temperature, or heat flux per area into the body
 };
 
+/// Multimaterial contact (docs/contact.md, seed 004). mode "none" keeps the single velocity field.
+struct ContactLawConfig {
+  std::string law = "frictionless";  ///< a ContactLaw registry name (contact/law.hpp)
+  double friction = 0.0;             ///< Coulomb: static coefficient (stick while |f_t| <= mu N)
+  double dynamic_friction = -1.0;    ///< Coulomb: sliding coefficient; < 0 = friction
+  std::string slide;                 ///< general: S_slide(Nc, vslip, t) expression
+};
+struct ContactPairConfig {
+  std::string first, second;  ///< field names (materials or bodies by [contact] mode)
+  ContactLawConfig law;
+  SourceLocation where;
+};
+struct ContactConfig {
+  std::string mode = "none";        ///< none | material | body
+  ContactLawConfig law;             ///< default law of every pair
+  std::string normal = "lr";        ///< lr | linear | ag | specified
+  std::vector<double> normal_direction;  ///< specified: from the first field to the second
+  std::string detection = "lr";     ///< lr | velocity | cp | df
+  double critical_separation = 0.8; ///< cp: delta_c in cells (seed 004 Eq. 16)
+  std::string corrections = "twice";///< twice | once (seed 004 Sec. 3.2)
+  std::string three_or_more = "lump";  ///< lump (Eq. 50) | pairs
+  bool xpic_correction = true;      ///< the Delta v term of multimaterial XPIC/FMPM (Eq. 37)
+  SourceLocation where;
+  std::vector<ContactPairConfig> pairs;  ///< [[contact_pair]]
+  [[nodiscard]] bool enabled() const { return mode != "none"; }
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -182,6 +222,7 @@ struct Config {
   std::vector<WallConfig> walls;                           ///< [[wall]]
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
   ThermalConfig thermal;
+  ContactConfig contact;
   OutputConfig output;
 };
 

@@ -21,6 +21,7 @@
 #include <optional>
 #include <sstream>
 
+#include "cairn/io/image.hpp"
 #include "cairn/io/schema.hpp"
 #include "cairn/materials/material.hpp"
 
@@ -223,7 +224,7 @@ const char* const face_names[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", 
 /// The sections written as arrays of tables ([[material]], ...), addressed by index in --set.
 bool is_table_array(const std::string& section) {
   return section == "material" || section == "body" || section == "traction" ||
-         section == "velocity" || section == "wall";
+         section == "velocity" || section == "wall" || section == "contact_pair";
 }
 const char* const face_condition_names[4] = {"free", "fixed", "symmetry", "periodic"};
 
@@ -351,13 +352,15 @@ class Loader {
   void read_constants(const toml::table& root, Config& cfg);
   void read_materials(const toml::table& root, Config& cfg);
   void read_bodies(const toml::table& root, Config& cfg);
-  BodyShapeConfig read_shape(TableReader& body);
+  /// `earlier`: the bodies read so far (an image named again is shared, not read again).
+  BodyShapeConfig read_shape(TableReader& body, const std::vector<BodyConfig>& earlier);
   void read_boundary(const toml::table& root, Config& cfg);
   void read_body_force(const toml::table& root, Config& cfg);
   void read_thermal(const toml::table& root, Config& cfg);
   void read_tractions(const toml::table& root, Config& cfg);
   void read_velocity_conditions(const toml::table& root, Config& cfg);
   void read_walls(const toml::table& root, Config& cfg);
+  void read_contact(const toml::table& root, Config& cfg);
   /// box_min/box_max of a selection: both or neither, max >= min on every axis.
   void read_box(TableReader& r, std::vector<double>& lo, std::vector<double>& hi);
   TimeTable read_table(TableReader& r);
@@ -940,7 +943,7 @@ void Loader::read_materials(const toml::table& root, Config& cfg) {
   }
 }
 
-BodyShapeConfig Loader::read_shape(TableReader& body) {
+BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConfig>& earlier) {
   const toml::node* node = body.given("shape");
   if (!node) body.fail("shape", nullptr, "an inline table with one shape kind (required key)", "nothing");
   std::vector<std::string> kinds;
@@ -1013,6 +1016,34 @@ BodyShapeConfig Loader::read_shape(TableReader& body) {
     }
     if (twice_area == 0.0)
       r.fail("vertices", r.given("vertices"), "vertices enclosing a non-zero area", "zero area");
+  } else if (kind == "image") {
+    const std::string file = r.string("file");
+    if (file.empty()) r.fail("file", r.given("file"), "a non-empty PNG file name", "\"\"");
+    s.file = resolve_input_relative(file, file_);
+    s.pixel_size = r.real("pixel_size");
+    s.origin = r.reals("origin", 2, false);
+    const std::string levels = "an array of 2 integers [lo, hi], each in 0..255";
+    if (const toml::node* lv = r.given("levels")) {
+      const toml::array* a = lv->as_array();
+      if (!a) r.fail("levels", lv, levels, typed_text(*lv));
+      if (a->size() != 2) r.fail("levels", lv, levels, fmt::format("{} ({} entries)", node_text(*lv), a->size()));
+    }
+    const std::vector<int> lh = r.integers("levels", 2, false);
+    s.level_min = lh[0];
+    s.level_max = lh[1];
+    if (s.level_min > s.level_max)
+      r.fail("levels", r.given("levels"), "levels [lo, hi] with lo <= hi",
+             fmt::format("lo = {} > hi = {}", s.level_min, s.level_max));
+    for (const auto& other : earlier)
+      if (other.shape.image && other.shape.file == s.file) s.image = other.shape.image;
+    if (!s.image) {
+      try {
+        s.image = std::make_shared<const GreyImage>(read_png_grey(s.file));
+      } catch (const std::invalid_argument& e) {
+        r.fail("file", r.given("file"), "a readable PNG file (relative to the input file's directory)",
+               e.what());
+      }
+    }
   } else {
     throw std::logic_error("input: shape kind '" + kind + "' declared but not read");
   }
@@ -1046,7 +1077,7 @@ void Loader::read_bodies(const toml::table& root, Config& cfg) {
                  : "the name of a [[material]], one of " + join(material_names) +
                        did_you_mean(b.material, material_names),
              toml_string(b.material));
-    b.shape = read_shape(r);
+    b.shape = read_shape(r, cfg.bodies);
     b.particles_per_cell = r.integers("particles_per_cell", n, true);
     b.velocity = r.expressions("velocity", n);
     if (b.velocity.empty()) b.velocity.assign(n, "0");
@@ -1317,6 +1348,74 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.checkpoints = r.boolean("checkpoints");
 }
 
+void Loader::read_contact(const toml::table& root, Config& cfg) {
+  const toml::table* t = section(root, "contact");
+  TableReader r(*this, t, {"contact"}, copy_section("contact"), "[contact]");
+  r.reject_unknown_keys();
+  ContactConfig& c = cfg.contact;
+  c.mode = r.string("mode");
+  c.where = {file_, t ? line_of(t) : 0};
+  std::vector<std::string> fields;
+  if (c.mode == "material")
+    for (const auto& m : cfg.materials) fields.push_back(m.name);
+  else if (c.mode == "body")
+    for (const auto& b : cfg.bodies) fields.push_back(b.name);
+  auto read_law = [](TableReader& lr) {
+    ContactLawConfig law;
+    law.law = lr.string("law");
+    law.friction = lr.real("friction");
+    law.dynamic_friction = lr.real("dynamic_friction");
+    law.slide = lr.expression("slide");
+    return law;
+  };
+  c.law = read_law(r);
+  c.normal = r.string("normal");
+  if (c.normal == "specified") {
+    if (!r.present("normal_direction"))
+      r.fail("normal_direction", nullptr, "a normal direction when normal = \"specified\"", "nothing");
+    c.normal_direction = r.reals("normal_direction", static_cast<std::size_t>(dim_), false);
+    double norm = 0.0;
+    for (double v : c.normal_direction) norm += v * v;
+    if (!(norm > 0.0))
+      r.fail("normal_direction", r.given("normal_direction"), "a non-zero vector", "a zero vector");
+  } else if (r.present("normal_direction")) {
+    c.normal_direction = r.reals("normal_direction", static_cast<std::size_t>(dim_), false);
+  }
+  c.detection = r.string("detection");
+  c.critical_separation = r.real("critical_separation");
+  c.corrections = r.string("corrections");
+  c.three_or_more = r.string("three_or_more");
+  c.xpic_correction = r.boolean("xpic_correction");
+
+  const toml::array* entries = root.get_as<toml::array>("contact_pair");
+  if (!entries) return;
+  for (std::size_t i = 0; i < entries->size(); ++i) {
+    const toml::table* e = entries->get(i)->as_table();
+    const Path path = child(Path{"contact_pair"}, i);
+    TableReader pr(*this, e, path, copy_section("contact_pair"), "[[contact_pair]]");
+    pr.reject_unknown_keys();
+    if (c.mode == "none")
+      fail(path, e, "a [contact] mode of material or body for [[contact_pair]] to apply", "mode = \"none\"");
+    ContactPairConfig pc;
+    for (const char* key : {"first", "second"}) {
+      const std::string name = pr.string(key);
+      if (index_of(fields, name) < 0)
+        pr.fail(key, pr.given(key),
+                fmt::format("the name of a {} (contact mode {}), one of {}{}",
+                            c.mode == "material" ? "[[material]]" : "[[body]]", c.mode, join(fields),
+                            did_you_mean(name, fields)),
+                toml_string(name));
+      (std::string(key) == "first" ? pc.first : pc.second) = name;
+    }
+    if (pc.first == pc.second)
+      pr.fail("second", pr.given("second"), "a field other than first", toml_string(pc.second));
+    if (!pr.present("law")) pr.fail("law", nullptr, "the pair's contact law", "nothing");
+    pc.law = read_law(pr);
+    pc.where = {file_, line_of(e)};
+    c.pairs.push_back(std::move(pc));
+  }
+}
+
 Config Loader::load(toml::table& root, const std::vector<std::string>& overrides) {
   for (const auto& o : overrides) apply_override(root, o);
   check_top_level(root);
@@ -1334,6 +1433,7 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   read_tractions(root, cfg);
   read_velocity_conditions(root, cfg);
   read_walls(root, cfg);
+  read_contact(root, cfg);
   read_output(root, cfg);
   cfg.resolved_toml = config_to_toml(cfg);
   return cfg;
@@ -1371,6 +1471,9 @@ std::string shape_text(const BodyShapeConfig& s) {
                          real_text(s.inner_radius), real_text(s.outer_radius));
   else if (s.kind == "polygon")
     params = "vertices = " + array_text(s.vertices, reals_text);
+  else if (s.kind == "image")
+    params = fmt::format("file = {}, pixel_size = {}, origin = {}, levels = [{}, {}]", toml_string(s.file),
+                         real_text(s.pixel_size), reals_text(s.origin), s.level_min, s.level_max);
   return fmt::format("{{ {} = {{ {} }} }}", toml_key(s.kind), params);
 }
 
@@ -1523,6 +1626,32 @@ std::string config_to_toml(const Config& c) {
   }
 
   const auto& out = c.output;
+  {
+    const ContactConfig& ct = c.contact;
+    auto law_lines = [&](const ContactLawConfig& law) {
+      line("law", toml_string(law.law));
+      line("friction", real_text(law.friction));
+      line("dynamic_friction", real_text(law.dynamic_friction));
+      line("slide", expression_text(law.slide));
+    };
+    o += "\n[contact]\n";
+    line("mode", toml_string(ct.mode));
+    law_lines(ct.law);
+    line("normal", toml_string(ct.normal));
+    if (!ct.normal_direction.empty()) line("normal_direction", reals_text(ct.normal_direction));
+    line("detection", toml_string(ct.detection));
+    line("critical_separation", real_text(ct.critical_separation));
+    line("corrections", toml_string(ct.corrections));
+    line("three_or_more", toml_string(ct.three_or_more));
+    line("xpic_correction", boolean(ct.xpic_correction));
+    for (const auto& pc : ct.pairs) {
+      o += "\n[[contact_pair]]\n";
+      line("first", toml_string(pc.first));
+      line("second", toml_string(pc.second));
+      law_lines(pc.law);
+    }
+  }
+
   o += "\n[output]\n";
   line("directory", toml_string(out.directory));
   line("every", real_text(out.every));

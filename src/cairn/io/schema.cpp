@@ -18,6 +18,9 @@ std::vector<std::string> face_conditions() { return {"free", "fixed", "symmetry"
 std::vector<std::string> boundary_acceleration_names() { return {"zero", "velocity_change"}; }
 std::vector<std::string> face_names_list() { return {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}; }
 std::vector<std::string> axis_names() { return {"x", "y", "z"}; }
+std::vector<std::string> contact_law_names() {
+  return {"perfect", "stick", "frictionless", "coulomb", "general"};
+}
 std::vector<std::string> mode_names() { return {"plane_strain", "plane_stress", "3d", "uniaxial"}; }
 
 /// Fluent construction of a KeyDecl (designated initializers that skip members warn under -Wextra).
@@ -256,6 +259,26 @@ std::vector<KeyDecl> make_declarations() {
                  "Radius.")
                 .required()
                 .min(above_zero));
+  k.push_back(Key("body.shape.image", "file", T::string,
+                 "PNG picture, relative to the directory of the input file (any PNG: colour "
+                 "becomes grey luma 0.2126 R + 0.7152 G + 0.0722 B, 16 bits become 8, alpha "
+                 "is ignored).")
+                .required());
+  k.push_back(Key("body.shape.image", "pixel_size", T::real,
+                 "Edge of one (square) pixel in length units.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.image", "origin", T::real_array,
+                 "Position [x, y] of the picture's lower-left corner: the picture covers "
+                 "width * pixel_size by height * pixel_size from there, its first (top) row at "
+                 "the highest y.")
+                .by_default("[0.0, 0.0]"));
+  k.push_back(Key("body.shape.image", "levels", T::integer_array,
+                 "Grey levels [lo, hi] (0 = black, 255 = white), lo <= hi: a particle position "
+                 "belongs to the body when the pixel under it has a level in lo..hi.")
+                .required()
+                .min(0)
+                .max(255));
 
   // [boundary]
   const char* faces[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
@@ -292,6 +315,77 @@ std::vector<KeyDecl> make_declarations() {
                    fmt::format("Temperature or heat flux of the {} face.", faces[i]))
                   .by_default("0.0"));
   }
+
+
+  // [contact] and [[contact_pair]] (seed 004, docs/contact.md)
+  k.push_back(Key("contact", "mode", T::string,
+                 "Multimaterial mode (seed 004 Eq. 5-6): none (one velocity field), material (one "
+                 "field per [[material]]) or body (one field per [[body]]). Nodes that see two or "
+                 "more fields are contact nodes.")
+                .by_default("\"none\"")
+                .choices([] { return std::vector<std::string>{"none", "material", "body"}; }));
+  for (const char* section : {"contact", "contact_pair"}) {
+    const bool pair = std::string(section) == "contact_pair";
+    auto law = Key(section, "law", T::string,
+                   pair ? "Contact law of this pair (see [contact] law)."
+                        : "Default contact law of every pair (seed 004 Eq. 7-10): perfect (bonded, no "
+                          "detection), stick, frictionless, coulomb or general.");
+    if (!pair) law.by_default("\"frictionless\"");
+    k.push_back(law.choices(contact_law_names));
+    k.push_back(Key(section, "friction", T::real,
+                   "Coulomb friction coefficient (static: the interface sticks while the tangential "
+                   "force needed is at most friction times the normal force).")
+                  .by_default("0.0")
+                  .min(0.0));
+    k.push_back(Key(section, "dynamic_friction", T::real,
+                   "Coulomb sliding coefficient; negative = friction.")
+                  .by_default("-1.0"));
+    k.push_back(Key(section, "slide", T::expression,
+                   "general: sliding traction S_slide as an expression in Nc (normal traction), "
+                   "vslip (tangential slip speed), t and [constants]; capped at the stick value.")
+                  .by_default("\"0\""));
+  }
+  k.push_back(Key("contact_pair", "first", T::string,
+                 "First field of the pair: a [[material]] name (mode material) or [[body]] name "
+                 "(mode body).")
+                .required());
+  k.push_back(Key("contact_pair", "second", T::string, "Second field of the pair.").required());
+  k.push_back(Key("contact", "normal", T::string,
+                 "Contact normal: lr (logistic regression on the point cloud, seed 004 Eq. 19-21, "
+                 "53-57), linear (its first, linear-regression iterate), ag (average volume "
+                 "gradient, Eq. 11-13) or specified (normal_direction).")
+                .by_default("\"lr\"")
+                .choices([] { return std::vector<std::string>{"lr", "linear", "ag", "specified"}; }));
+  k.push_back(Key("contact", "normal_direction", T::real_array,
+                 "specified: the normal, one entry per axis, pointing from the lower-numbered field "
+                 "to the higher-numbered one."));
+  k.push_back(Key("contact", "detection", T::string,
+                 "Contact detection; every method also needs approach, (v_b - v_a).n < 0: lr "
+                 "(separation of the point clouds with deformed particle radii, Eq. 22-25), "
+                 "velocity (approach alone, Eq. 14), cp (extrapolated positions closer than "
+                 "critical_separation cells, Eq. 16) or df (edge distances from the tabulated "
+                 "d(x) of the shape family, Eq. 15).")
+                .by_default("\"lr\"")
+                .choices([] { return std::vector<std::string>{"lr", "velocity", "cp", "df"}; }));
+  k.push_back(Key("contact", "critical_separation", T::real,
+                 "cp: critical separation delta_c in cells (seed 004 Eq. 16).")
+                .by_default("0.8")
+                .min(0.0));
+  k.push_back(Key("contact", "corrections", T::string,
+                 "twice: correct the extrapolated momenta and the updated momenta (seed 004 Eq. "
+                 "26-34); once: only the updated momenta (for comparison).")
+                .by_default("\"twice\"")
+                .choices([] { return std::vector<std::string>{"twice", "once"}; }));
+  k.push_back(Key("contact", "three_or_more", T::string,
+                 "Nodes that see three or more fields: lump (each field against all others lumped, "
+                 "Eq. 50) or pairs (the pairs in contact solved together; lumped when three or "
+                 "more pairs touch).")
+                .by_default("\"lump\"")
+                .choices([] { return std::vector<std::string>{"lump", "pairs"}; }));
+  k.push_back(Key("contact", "xpic_correction", T::boolean,
+                 "Add the Delta v term of multimaterial XPIC(m) and FMPM(k) (seed 004 Eq. 37, seed "
+                 "000 Eq. 5); false gives the uncorrected variant.")
+                .by_default("true"));
 
   // [body_force]
   k.push_back(Key("body_force", "expression", T::expression_array,
@@ -432,6 +526,8 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.annulus.center", "real[2]"},
       {"body.shape.sphere.center", "real[3]"},
       {"body.shape.polygon.vertices", "real[2][n]"},
+      {"body.shape.image.origin", "real[2]"},
+      {"body.shape.image.levels", "integer[2]"},
       {"traction.table", "real[2][n]"},
       {"velocity.table", "real[2][n]"},
       {"wall.table", "real[2][n]"},
@@ -589,6 +685,22 @@ const std::vector<SectionDoc>& section_docs() {
        "velocity = 0.025\n"
        "gradient = \"estimate\"\n"
        "depth = 1.5\n"},
+      {"contact", "[contact]",
+       "Multimaterial contact (seed 004; docs/contact.md): one velocity field per material or "
+       "body, contact corrections twice per step, the contact law of each pair, normals and "
+       "detection. History gets contact_nodes, contact_active and the force on each field pair.",
+       "[contact]\n"
+       "mode = \"material\"\n"
+       "law = \"coulomb\"\n"
+       "friction = 0.2\n"
+       "normal = \"lr\"\n"
+       "detection = \"lr\"\n"},
+      {"contact_pair", "[[contact_pair]]",
+       "The contact law of one pair of fields, overriding the [contact] default.",
+       "[[contact_pair]]\n"
+       "first = \"steel\"\n"
+       "second = \"rock\"\n"
+       "law = \"perfect\"\n"},
       {"output", "[output]",
        "What is written, where and how often.",
        "[output]\n"
@@ -708,7 +820,7 @@ std::string markdown_text() {
       out +=
           "\n### shape kinds\n\n"
           "`shape` holds exactly one of these kinds, each an inline table of its parameters "
-          "(all required).\n\n"
+          "(required unless a default is shown).\n\n"
           "| kind | dimensions | doc |\n|---|---|---|\n";
       for (const auto& kind : body_shape_kinds()) {
         std::vector<std::string> dims;
@@ -720,6 +832,27 @@ std::string markdown_text() {
       md_header(out);
       for (const auto& kind : body_shape_kinds())
         md_rows(out, copy_section("body.shape." + kind.name), kind.name + ".");
+      out +=
+          "\nAn `image` body is drawn as a picture (seed 004 Sec. 4.2): a particle position X "
+          "belongs to it when the pixel under X has a grey level in `levels`. Pixel (col, row) of "
+          "a W x H picture covers x in [x0 + col s, x0 + (col + 1) s), y in [y0 + (H - 1 - row) s, "
+          "y0 + (H - row) s), with s = pixel_size and [x0, y0] = origin: row 0, the first row of "
+          "the file, is the top of the picture, at the highest y. Positions outside the picture "
+          "are outside the body, and a position on a pixel edge (to 1e-6 pixel) belongs to the pixel "
+          "on its +x / +y side. A picture whose shades mark several materials becomes one "
+          "[[body]] per shade (or range of shades), each with its own material:\n\n"
+          "```toml\n"
+          "[[body]]\n"
+          "material = \"grain1\"\n"
+          "shape = { image = { file = \"ellipses.png\", pixel_size = 3.5714e-6, levels = [10, 10] } }\n"
+          "\n"
+          "[[body]]\n"
+          "material = \"grain2\"\n"
+          "shape = { image = { file = \"ellipses.png\", pixel_size = 3.5714e-6, levels = [20, 20] } }\n"
+          "```\n\n"
+          "The picture is read once per file when the input is loaded (a missing or unreadable "
+          "file is an input error at the `file` key); the resolved input (`cairn check`, "
+          "checkpoints) names it by its absolute path, so a restart needs the file still there.\n";
     }
   }
   return out;
@@ -801,7 +934,8 @@ const std::vector<std::string>& section_names() {
   static const std::vector<std::string> names{"simulation", "grid",     "method",
                                               "constants",  "material", "body",
                                               "boundary",   "thermal",    "body_force", "traction",
-                                              "velocity",   "wall",       "output"};
+                                              "velocity",   "wall",       "contact",    "contact_pair",
+                                              "output"};
   return names;
 }
 
@@ -813,6 +947,9 @@ const std::vector<BodyShapeKind>& body_shape_kinds() {
       {"annulus", {false, true, false}, "Ring between two concentric circles."},
       {"polygon", {false, true, false}, "Simple polygon."},
       {"sphere", {false, false, true}, "Ball."},
+      {"image", {false, true, false},
+       "Pixels of a grey-level PNG picture whose level lies in a range (one body per "
+       "material shade)."},
   };
   return kinds;
 }

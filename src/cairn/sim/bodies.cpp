@@ -3,17 +3,26 @@
 // of its lattice cell (times the thickness in 2D, the cross-section in 1D), mass rho0 V0 and
 // edge lengths h / ppc. An optional displacement field u(X) places it at x = X + u(X) with
 // F = I + grad u (central differences), and its initial velocity is evaluated at X.
+//
+// An image shape (2D) keeps X when the pixel under it has a grey level in [level_min,
+// level_max]: pixel (col, row) of a W x H picture covers [ox + col s, ox + (col + 1) s) x
+// [oy + (H - 1 - row) s, oy + (H - row) s), so row 0 (the top of the picture) lies at the
+// highest y; positions outside the picture are outside the body. A position on a pixel edge
+// (to 1e-6 pixel, so that rounding does not decide) belongs to the pixel on its +x / +y side:
+// lattices whose points fall on pixel corners sample the picture consistently.
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/io/image.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {
 namespace {
 
 template <int D>
-bool inside(const BodyShapeConfig& s, const Vec<D>& x) {
+bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
   auto vec = [](const std::vector<double>& v) {
     Vec<D> out = Vec<D>::Zero();
     for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
@@ -42,6 +51,20 @@ bool inside(const BodyShapeConfig& s, const Vec<D>& x) {
           in = !in;
       }
       return in;
+    }
+  }
+  if (s.kind == "image" && image) {
+    if constexpr (D == 2) {
+      const Vec<D> o = vec(s.origin);
+      auto pixel = [&](double t) {
+        const double r = std::round(t);
+        return std::floor(std::abs(t - r) <= 1e-6 ? r : t);
+      };
+      const double u = pixel((x[0] - o[0]) / s.pixel_size);
+      const double v = pixel((x[1] - o[1]) / s.pixel_size);
+      if (!(u >= 0.0 && u < image->width && v >= 0.0 && v < image->height)) return false;
+      const int level = image->at(static_cast<int>(u), image->height - 1 - static_cast<int>(v));
+      return level >= s.level_min && level <= s.level_max;
     }
   }
   return false;
@@ -78,6 +101,18 @@ void create_particles(const Config& config, const Grid<D>& grid,
       throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
     }
 
+    // The picture of an image shape: read by the loader, else (a Config built in code) here,
+    // once per body rather than per lattice point.
+    std::shared_ptr<const GreyImage> image = body.shape.image;
+    if (body.shape.kind == "image" && !image) {
+      try {
+        image = std::make_shared<const GreyImage>(
+            read_png_grey(resolve_input_relative(body.shape.file, config.source_file)));
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
+      }
+    }
+
     const std::size_t before = particles.n();
     const IVec<D> n_cells = grid.n_cells();
     IVec<D> n_points = n_cells.cwiseProduct(ppc);
@@ -91,7 +126,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
         rem /= n_points[a];
         X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
       }
-      if (!inside<D>(body.shape, X)) continue;
+      if (!inside<D>(body.shape, image.get(), X)) continue;
       const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
       particles.add(X, v0, mass, vol, lp, mat, static_cast<std::int32_t>(b));
       {

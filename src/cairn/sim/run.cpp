@@ -26,7 +26,9 @@ const std::vector<std::string> history_columns = {
 
 /// The columns of history.csv: the fixed ones, then per [[velocity]]/[[wall]] its reaction force
 /// reaction_<name>_<axis> (seed 000 Sec. 2.4, summed over its nodes, from the last step), then per
-/// wall its position wall_<name>_position.
+/// wall its position wall_<name>_position; in multimaterial mode contact_nodes (nodes seeing two or
+/// more fields), contact_active (nodes corrected by the last momentum-update pass) and per field
+/// pair the contact force on the first from the second, contact_<a>_<b>_<axis> (seed 004 Eq. 33).
 template <int D>
 std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
   std::vector<std::string> columns = history_columns;
@@ -34,6 +36,13 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
     for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
   for (const auto& wall : sim.velocity_conditions().walls())
     columns.push_back(fmt::format("wall_{}_position", wall.name()));
+  if (const auto* c = sim.contact()) {
+    columns.push_back("contact_nodes");
+    columns.push_back("contact_active");
+    for (const auto& [a, b] : c->pairs())
+      for (int k = 0; k < D; ++k)
+        columns.push_back(fmt::format("contact_{}_{}_{}", c->field_names()[a], c->field_names()[b], "xyz"[k]));
+  }
   return columns;
 }
 
@@ -157,6 +166,12 @@ class Runner {
     for (const auto& r : sim_.velocity_conditions().reactions())
       for (int a = 0; a < D; ++a) row.push_back(r[a]);
     for (const auto& wall : sim_.velocity_conditions().walls()) row.push_back(wall.position());
+    if (const auto* c = sim_.contact()) {
+      row.push_back(static_cast<double>(c->contact_nodes()));
+      row.push_back(static_cast<double>(c->active_nodes()));
+      for (const auto& f : c->pair_forces())
+        for (int a = 0; a < D; ++a) row.push_back(f[a]);
+    }
     history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_, row);
     ++rows_since_flush_;
     if (rows_since_flush_ >= 20) {
@@ -169,7 +184,10 @@ class Runner {
     if (!config_.output.snapshots) return;
     history_writer_.flush();
     if (config_.output.grid_snapshots)
-      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &sim_.nodes());
+    {
+      const NodeField<D> nodes = sim_.grid_totals();
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &nodes);
+    }
     else
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
   }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "cairn/contact/contact.hpp"
 #include "cairn/materials/plane_stress.hpp"
 #include "cairn/math/tensor.hpp"
 #include "cairn/transfer/transfer.hpp"
@@ -55,7 +56,6 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
-  nodes_.resize(grid_.n_nodes());
   for (const auto& m : materials_) material_density_.push_back(m->density());
   if (config_.thermal.conduction) {
     std::vector<double> k, cp;
@@ -66,14 +66,25 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     conduction_ = std::make_unique<Conduction<D>>(config_.thermal, grid_, k, cp,
                                                   config_.simulation.thickness);
   }
-  grid_term_.assign(grid_.n_nodes(), Vec<D>::Zero());
-  grid_proj_.assign(grid_.n_nodes(), Vec<D>::Zero());
-  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
-  particle_scalar_.assign(particles_.n(), 0.0);
-  body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
   double max_mass = 0.0;
   for (double m : particles_.mass) max_mass = std::max(max_mass, m);
   small_mass_ = 1e-15 * max_mass;  // nodes below this hold no velocity
+  if (config_.contact.enabled()) {
+    // Multimaterial mode: one field per material or body, side by side (contact/contact.hpp).
+    contact_ = std::make_unique<Contact<D>>(config_, grid_, particles_, small_mass_);
+    n_fields_ = contact_->n_fields();
+    contact_dv_.assign(n_slots(), Vec<D>::Zero());
+    totals_.mass.assign(grid_.n_nodes(), 0.0);
+    totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
+    field_offset_.resize(particles_.n());
+    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+  }
+  nodes_.resize(n_slots());
+  grid_term_.assign(n_slots(), Vec<D>::Zero());
+  grid_proj_.assign(n_slots(), Vec<D>::Zero());
+  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
+  particle_scalar_.assign(particles_.n(), 0.0);
+  body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
   tractions_ = Tractions<D>(config_, grid_, particles_);
@@ -85,7 +96,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
                                                                   config_.constants));
     body_force_constant_ = body_force_[0]->is_constant();
     if (body_force_constant_) body_force_value_ = (*body_force_[0])(Vec<D>::Zero(), Vec<D>::Zero(), 0.0);
-    node_body_force_.assign(grid_.n_nodes(), Vec<D>::Zero());
+    node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
 }
 
@@ -171,7 +182,7 @@ void Simulation<D>::step(double dt) {
   if (stress_first) {
     // USF / USAVG: update stresses from v = m^-1 p (m~_k^-1 p under FMPM) before the forces.
     particles_to_grid(true, false);
-    velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
+    velocity_conditions_.prepare(grid_, contact_ ? totals_ : nodes_, small_mass_, time_, dt);
     lap(1);
     stress_velocity_from_momentum(nodes_.momentum, fmpm_velocities);
     lap(3);
@@ -180,7 +191,7 @@ void Simulation<D>::step(double dt) {
     particles_to_grid(false, true);
   } else {
     particles_to_grid(true, true);
-    velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
+    velocity_conditions_.prepare(grid_, contact_ ? totals_ : nodes_, small_mass_, time_, dt);
   }
   lap(1);
   update_grid(dt);
@@ -189,6 +200,7 @@ void Simulation<D>::step(double dt) {
     // seed 000 Task 3: v+ = m~_k^-1 p+ (FMPM) or v = m~_k^-1 p (XPIC, blends).
     full_mass_velocity(need == FullMass::of_updated ? nodes_.velocity_new : nodes_.velocity,
                        nodes_.velocity_full, k);
+    if (contact_ && contact_->xpic_correction()) subtract_contact_term(nodes_.velocity_full, k);
   }
   lap(3);
   update_particles(dt);
@@ -222,6 +234,7 @@ template <int D>
 void Simulation<D>::build_stencils() {
   shape_->build(grid_, particles_, cache_);
   colour_blocks(grid_, cache_);
+  if (contact_) contact_->fill_slots(particles_, cache_);
 }
 
 template <int D>
@@ -259,7 +272,8 @@ template <int D>
 void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   const bool has_body_force = !body_force_.empty();
   const bool affine = scheme_->affine();
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+  const std::int32_t* idx = slots();
+  for_each_node(n_slots(), [&](std::int32_t i) {
     if (mass_and_momentum) {
       nodes_.mass[i] = 0.0;
       nodes_.momentum[i].setZero();
@@ -274,12 +288,12 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   const auto& P = particles_;
   // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
   scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    const std::int32_t i = cache_.node[s];
+    const std::int32_t i = idx[s];
     const double Sm = cache_.weight[s] * P.mass[p];
     if (mass_and_momentum) {
       nodes_.mass[i] += Sm;
       if (affine) {
-        const Vec<D> dx = node_offset(grid_, i, P.position[p]);
+        const Vec<D> dx = node_offset(grid_, cache_.node[s], P.position[p]);
         nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
       } else {
         nodes_.momentum[i] += Sm * P.velocity[p];
@@ -295,7 +309,28 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
     }
   });
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
-  if (forces) tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force);
+  if (forces)
+    tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
+                          contact_ ? &field_offset_ : nullptr);
+  if (mass_and_momentum && contact_) {
+    // Multimaterial: contact nodes, normals and separations of this step, then the first
+    // correction p^a = p^a0 + dp^a kept as dv^a (seed 004 Eq. 26).
+    contact_->prepare(particles_, cache_, nodes_.mass);
+    if (contact_->corrects_extrapolation())
+      contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, step_dt_,
+                        &contact_dv_);
+    const std::int32_t nn = grid_.n_nodes();
+    for_each_node(nn, [&](std::int32_t i) {
+      double m = 0.0;
+      Vec<D> q = Vec<D>::Zero();
+      for (int f = 0; f < n_fields_; ++f) {
+        m += nodes_.mass[f * nn + i];
+        q += nodes_.momentum[f * nn + i];
+      }
+      totals_.mass[i] = m;
+      totals_.momentum[i] = q;
+    });
+  }
 }
 
 template <int D>
@@ -304,7 +339,7 @@ void Simulation<D>::update_grid(double dt) {
   // difference start uses half the first acceleration (seed 001 Sec. 4.7, seed 003 Eq. 11-15).
   const double f_scale =
       (config_.method.time_integration == "central_difference" && step_ == 0) ? 0.5 : 1.0;
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+  for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (m > small_mass_) {
       nodes_.velocity[i] = nodes_.momentum[i] / m;
@@ -314,15 +349,24 @@ void Simulation<D>::update_grid(double dt) {
       nodes_.velocity_new[i].setZero();
     }
   });
-  conditions_.apply_step(nodes_, dt);
-  velocity_conditions_.apply_step(nodes_, dt, config_.boundary.acceleration == BoundaryAcceleration::zero);
+  // Second contact correction, on the updated momenta: dp^a+ / dt is the contact force and the
+  // acceleration is (v^a+ - v^a) / dt with the corrected v^a (seed 004 Eq. 30-34).
+  if (contact_)
+    contact_->correct(nodes_.mass, nodes_.velocity_new, false, Contact<D>::Pass::updated, time_, dt, nullptr);
+  for (int f = 0; f < n_fields_; ++f) {
+    const std::int32_t off = f * grid_.n_nodes();
+    conditions_.apply_step(nodes_, dt, off);
+    velocity_conditions_.apply_step(nodes_, dt, config_.boundary.acceleration == BoundaryAcceleration::zero, off,
+                                    f == 0);
+  }
 
   // External work of this step: body forces, tractions and reactions at the mean grid velocity.
   const bool has_body_force = !body_force_.empty();
   if (!tractions_.empty())
-    external_work_ += 0.5 * dt * (tractions_.power(nodes_.velocity) + tractions_.power(nodes_.velocity_new));
+    external_work_ += 0.5 * dt * (tractions_.power(nodes_.velocity, contact_ ? &field_offset_ : nullptr) +
+                                  tractions_.power(nodes_.velocity_new, contact_ ? &field_offset_ : nullptr));
   if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
-    external_work_ += dt * chunked_sum<double>(grid_.n_nodes(), 0.0, [&](std::int64_t i) {
+    external_work_ += dt * chunked_sum<double>(n_slots(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
       double w = nodes_.reaction[i].dot(v_mean);
       if (has_body_force) w += node_body_force_[i].dot(v_mean);
@@ -334,16 +378,17 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
+  const std::int32_t* idx = slots();
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     Vec<D> u = Vec<D>::Zero();
-    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[cache_.node[s]];
+    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[idx[s]];
     particle_vec_[p] = u;
   });
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { out[i].setZero(); });
+  for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
   scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    out[cache_.node[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
+    out[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
   });
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+  for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
   });
@@ -364,16 +409,16 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
   const bool from_p = &in == &nodes_.velocity, from_p_new = &in == &nodes_.velocity_new;
   const bool uncorrected_start = method == "velocity" && (!conditions_.empty() || !velocity_conditions_.empty()) &&
                                  (from_p || from_p_new);
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+  for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (!uncorrected_start) grid_term_[i] = in[i];
     else if (m <= small_mass_) grid_term_[i].setZero();
     else grid_term_[i] = (nodes_.momentum[i] + (from_p_new ? Vec<D>(nodes_.force[i] * step_dt_) : Vec<D>::Zero())) / m;
   });
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
+  for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
   for (int j = 1; j < k; ++j) {
     lumped_projection(grid_term_, grid_proj_);
-    for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+    for_each_node(n_slots(), [&](std::int32_t i) {
       grid_term_[i] -= grid_proj_[i];  // A^j in
       out[i] += grid_term_[i];
     });
@@ -384,13 +429,35 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
 
 template <int D>
 void Simulation<D>::impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when) {
-  conditions_.apply(velocity, nodes_.mass, nullptr, 1.0);
-  velocity_conditions_.apply(velocity, when);
+  for (int f = 0; f < n_fields_; ++f) {
+    const std::int32_t off = f * grid_.n_nodes();
+    conditions_.apply(velocity, nodes_.mass, nullptr, 1.0, off);
+    velocity_conditions_.apply(velocity, when, off);
+  }
+}
+
+template <int D>
+void Simulation<D>::subtract_contact_term(std::vector<Vec<D>>& out, int k) {
+  // Multimaterial XPIC(k)/FMPM(k): out -= m~_(k-1)^-1 m dv^a, the (I - S S+a)^(k-1) S dv^a term
+  // of seed 004 Eq. 37 / 42-44 in the full-mass form of seed 000 Eq. 5: the sum of A^j dv,
+  // j = 0 .. k-2, with A = I - S+a S per field.
+  if (k < 2) return;
+  for_each_node(n_slots(), [&](std::int32_t i) {
+    grid_term_[i] = contact_dv_[i];
+    out[i] -= contact_dv_[i];
+  });
+  for (int j = 1; j < k - 1; ++j) {
+    lumped_projection(grid_term_, grid_proj_);
+    for_each_node(n_slots(), [&](std::int32_t i) {
+      grid_term_[i] -= grid_proj_[i];
+      out[i] -= grid_term_[i];
+    });
+  }
 }
 
 template <int D>
 void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass) {
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) {
+  for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     nodes_.velocity_work[i] = m > small_mass_ ? Vec<D>(momentum[i] / m) : Vec<D>::Zero();
   });
@@ -407,10 +474,13 @@ void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& mom
 
 template <int D>
 void Simulation<D>::reextrapolate_momentum() {
-  for_each_node(grid_.n_nodes(), [&](std::int32_t i) { grid_term_[i].setZero(); });
+  const std::int32_t* idx = slots();
+  for_each_node(n_slots(), [&](std::int32_t i) { grid_term_[i].setZero(); });
   scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    grid_term_[cache_.node[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
+    grid_term_[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
   });
+  if (contact_)  // the re-extrapolated momenta obey contact too (same normals and separations)
+    contact_->correct(nodes_.mass, grid_term_, true, Contact<D>::Pass::stress, time_, step_dt_, nullptr);
 }
 
 template <int D>
@@ -426,10 +496,11 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
+  const std::int32_t* idx = slots();
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
     for (std::size_t s = begin; s < end; ++s) {
-      const std::int32_t i = cache_.node[s];
+      const std::int32_t i = idx[s];
       const double S = cache_.weight[s];
       g.Sv += S * v[i];
       g.Sv_new += S * v_new[i];
@@ -452,7 +523,7 @@ void Simulation<D>::update_particles(double dt) {
       Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
       for (std::size_t s = begin; s < end; ++s) {
         const Vec<D> d = node_offset(grid_, cache_.node[s], x_old);
-        B += cache_.weight[s] * v_new[cache_.node[s]] * d.transpose();
+        B += cache_.weight[s] * v_new[idx[s]] * d.transpose();
         Dp += cache_.weight[s] * d * d.transpose();
       }
       P.affine_velocity[p].setZero();
@@ -484,10 +555,11 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
+  const std::int32_t* idx = slots();
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     Mat3 L = Mat3::Zero();
     for (std::size_t s = begin; s < end; ++s)
-      L.template topLeftCorner<D, D>() += grid_velocity[cache_.node[s]] * cache_.gradient[s].transpose();
+      L.template topLeftCorner<D, D>() += grid_velocity[idx[s]] * cache_.gradient[s].transpose();
     particles_.velocity_gradient[p] = L;
     Mat3& F = particles_.deformation_gradient[p];
     const Mat3 dF = tensor_exp(L * dt);
@@ -516,6 +588,33 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
                             "particle " + std::to_string(first_bad) + " (body " +
                                 std::to_string(particles_.body[p]) + "): " + value);
   }
+}
+
+template <int D>
+NodeField<D> Simulation<D>::grid_totals() const {
+  if (!contact_) return nodes_;
+  const std::int32_t nn = grid_.n_nodes();
+  NodeField<D> t;
+  t.resize(nn);
+  for (std::int32_t i = 0; i < nn; ++i) {
+    for (int f = 0; f < n_fields_; ++f) {
+      const std::int32_t s = f * nn + i;
+      t.mass[i] += nodes_.mass[s];
+      t.momentum[i] += nodes_.momentum[s];
+      t.force[i] += nodes_.force[s];
+      t.velocity_new[i] += nodes_.mass[s] * nodes_.velocity_new[s];
+      t.velocity[i] += nodes_.mass[s] * nodes_.velocity[s];
+      t.reaction[i] += nodes_.reaction[s];
+    }
+    if (t.mass[i] > small_mass_) {
+      t.velocity_new[i] /= t.mass[i];
+      t.velocity[i] /= t.mass[i];
+    } else {
+      t.velocity_new[i].setZero();
+      t.velocity[i].setZero();
+    }
+  }
+  return t;
 }
 
 template <int D>

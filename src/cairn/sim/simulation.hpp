@@ -12,6 +12,7 @@
 #include "cairn/bc/grid_conditions.hpp"
 #include "cairn/bc/traction.hpp"
 #include "cairn/bc/velocity_conditions.hpp"
+#include "cairn/contact/contact.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
 #include "cairn/materials/material.hpp"
@@ -68,7 +69,13 @@ class Simulation {
   // ---- state ----------------------------------------------------------------------------------
   [[nodiscard]] const Config& config() const { return config_; }
   [[nodiscard]] const Grid<D>& grid() const { return grid_; }
+  /// Node fields; in multimaterial mode field f of node i is entry f * n_nodes + i.
   [[nodiscard]] const NodeField<D>& nodes() const { return nodes_; }
+  /// Multimaterial contact ([contact] mode), or null in single-field mode.
+  [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
+  /// Node fields summed over the material fields (mass, momentum, velocity_new as m-weighted
+  /// mean); the node fields themselves in single-field mode. For grid snapshots.
+  [[nodiscard]] NodeField<D> grid_totals() const;
   [[nodiscard]] Particles<D>& particles() { return particles_; }
   [[nodiscard]] const Particles<D>& particles() const { return particles_; }
   [[nodiscard]] const TransferCache<D>& cache() const { return cache_; }
@@ -108,6 +115,12 @@ class Simulation {
   /// with conditions, or m~_k^-1 q for FMPM.
   void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
   void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
+  /// Multimaterial XPIC/FMPM: out -= m~_(k-1)^-1 m dv^a (seed 004 Eq. 37, seed 000 Eq. 5).
+  void subtract_contact_term(std::vector<Vec<D>>& out, int k);
+  /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
+  [[nodiscard]] std::int32_t n_slots() const { return grid_.n_nodes() * n_fields_; }
+  /// Per stencil entry, the index into the node arrays (cache.slot in multimaterial mode).
+  [[nodiscard]] const std::int32_t* slots() const { return contact_ ? cache_.slot.data() : cache_.node.data(); }
   /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
   /// with the values of the start or the end of the step.
   void impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when);
@@ -144,6 +157,11 @@ class Simulation {
   /// Which values a full-mass expansion of nodes_.velocity_work re-imposes (USF: start, USL+: end).
   typename VelocityConditions<D>::When work_when_ = VelocityConditions<D>::When::start;
   double small_mass_ = 0.0;
+  std::unique_ptr<Contact<D>> contact_;      ///< multimaterial mode ([contact] mode != none)
+  int n_fields_ = 1;
+  std::vector<Vec<D>> contact_dv_;           ///< dv^a of the first correction (slots)
+  NodeField<D> totals_;                      ///< multimaterial: mass and momentum summed over fields
+  std::vector<std::int32_t> field_offset_;   ///< multimaterial: field * n_nodes per particle
   double time_ = 0.0;
   long long step_ = 0;
   double external_work_ = 0.0;

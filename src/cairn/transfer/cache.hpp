@@ -15,6 +15,9 @@ template <int D>
 struct TransferCache {
   int stride = 0;                    ///< stencil slots per particle (the family's maximum)
   std::vector<std::int32_t> node;    ///< n*stride node indices (storage numbering)
+  /// Multimaterial mode only: node + field * n_nodes of each entry, the index into per-field
+  /// node arrays (contact/contact.hpp); empty otherwise.
+  std::vector<std::int32_t> slot;
   std::vector<double> weight;        ///< S_pi
   std::vector<Vec<D>> gradient;      ///< G_pi = grad S_pi (physical units)
   std::vector<std::uint16_t> count;  ///< number of used slots per particle

@@ -1,0 +1,119 @@
+// Multimaterial contact (seed 004; docs/contact.md).
+//
+// In multimaterial mode every field (a material or a body, [contact] mode) extrapolates to its
+// own nodal mass and momentum (seed 004 Eq. 5-6). The simulation stores the fields of one node
+// side by side: slot = field * n_nodes + node, and the transfer cache gets a per-entry slot index
+// so that every transfer of the step reads and writes the particle's own field. A node that sees
+// two or more fields is a contact node. Contact<D> finds those nodes, their normals and
+// separations once per step (prepare), and corrects a nodal field for contact (correct):
+//   - after the extrapolation of momenta: p^a = p^a0 + dp^a, kept as dv^a = dp^a / m^a (Eq. 26);
+//   - after the momentum update: p^a+ = p^a0+ + dp^a+, whose dp^a+ / dt is the contact force
+//     (Eq. 30-31, 33: f^aC,1), so that a^a = (v^a+ - v^a) / dt (Eq. 34, option 1);
+//   - on re-extrapolated momenta of USL+/USAVG+ before their stress update.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cairn/contact/law.hpp"
+#include "cairn/grid/grid.hpp"
+#include "cairn/io/config.hpp"
+#include "cairn/materials/material.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/shapes/shape_family.hpp"
+#include "cairn/transfer/cache.hpp"
+
+namespace cairn {
+
+template <int D>
+class Contact {
+ public:
+  Contact(const Config& config, const Grid<D>& grid, const Particles<D>& particles, double small_mass);
+  ~Contact();
+
+  [[nodiscard]] int n_fields() const { return static_cast<int>(field_names_.size()); }
+  [[nodiscard]] const std::vector<std::string>& field_names() const { return field_names_; }
+  /// Field of particle p (its material or body index).
+  [[nodiscard]] std::int32_t field_of(const Particles<D>& particles, std::size_t p) const {
+    return by_body_ ? particles.body[p] : particles.material[p];
+  }
+  /// cache.slot[s] = node + field * n_nodes for every stencil entry.
+  void fill_slots(const Particles<D>& particles, TransferCache<D>& cache) const;
+
+  /// Find the contact nodes and their normals and separations from the fields' masses
+  /// (slots) and the particles (seed 004 Sec. 2.3, 3.1).
+  void prepare(const Particles<D>& particles, const TransferCache<D>& cache, const std::vector<double>& mass);
+
+  enum class Pass { extrapolated, updated, stress };
+  /// Correct `values` (momenta when `momentum`, else velocities; slots) at the contact nodes.
+  /// `dv` (slots), when given, receives dp / m (extrapolated pass). The updated pass records the
+  /// contact forces dp / dt per field pair and the number of nodes in contact.
+  void correct(const std::vector<double>& mass, std::vector<Vec<D>>& values, bool momentum, Pass pass,
+               double time, double dt, std::vector<Vec<D>>* dv);
+
+  /// Nodes that see two or more fields (last prepare).
+  [[nodiscard]] std::size_t contact_nodes() const { return nodes_.size(); }
+  /// Nodes where the last updated pass changed the momenta.
+  [[nodiscard]] std::size_t active_nodes() const { return active_; }
+  /// Pairs (a, b), a < b, reported in history: force on a from b of the last updated pass.
+  [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
+  [[nodiscard]] const std::vector<Vec3>& pair_forces() const { return pair_force_; }
+  /// Unit contact normal per grid node (zero away from contact nodes), for grid snapshots.
+  void node_normals(std::vector<Vec3>& out) const;
+  [[nodiscard]] bool corrects_extrapolation() const { return twice_; }
+  [[nodiscard]] bool xpic_correction() const { return xpic_correction_; }
+
+ private:
+  struct Interaction {
+    std::int32_t a = 0;   ///< field alpha
+    std::int32_t b = -1;  ///< field beta; -1: every other field lumped (Eq. 50)
+    std::int32_t law = 0; ///< index into laws_
+    Vec3 normal = Vec3::Zero();   ///< unit, from alpha to beta
+    double separation = -1.0;     ///< < 0: touching
+    double area = 0.0;
+  };
+  void geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
+                const std::vector<double>& mass, std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c,
+                std::vector<std::int32_t>& cloud_p, Interaction& it) const;
+  [[nodiscard]] double contact_area(const Vec3& n) const;
+  [[nodiscard]] int law_of(int a, int b) const { return pair_law_[static_cast<std::size_t>(a * n_fields() + b)]; }
+  [[nodiscard]] double edge_distance(double s) const;  ///< DF: d(s) of a field on the -n side
+
+  const Grid<D>* grid_;
+  ContactConfig cfg_;
+  bool by_body_ = false;
+  bool twice_ = true;
+  bool xpic_correction_ = true;
+  double small_mass_ = 0.0;
+  std::int32_t n_nodes_ = 0;
+  std::vector<std::string> field_names_;
+  std::vector<std::unique_ptr<ContactLaw>> laws_;
+  std::vector<int> pair_law_;  ///< n_fields^2 law indices
+  Vec3 specified_ = Vec3::Zero();
+  bool need_clouds_ = false, need_gradient_ = false, need_position_ = false;
+
+  // per step
+  std::vector<std::int32_t> nodes_;        ///< contact nodes
+  std::vector<std::int32_t> contact_of_;   ///< grid node -> index into nodes_ or -1
+  std::vector<std::int32_t> field_begin_;  ///< CSR: fields present at contact node c
+  std::vector<std::int32_t> fields_;
+  std::vector<std::int32_t> cloud_begin_;  ///< CSR: particles whose stencil holds contact node c
+  std::vector<std::int32_t> cloud_;
+  std::vector<std::int32_t> inter_begin_;  ///< CSR: interactions of contact node c
+  std::vector<Interaction> inter_;
+  std::vector<Vec<D>> gradient_;  ///< AG: sum_p G_ip V_p per slot (Eq. 11)
+  std::vector<Vec<D>> position_;  ///< CP/DF: S+ X per slot (Eq. 11), relative to the node
+
+  // DF table: extrapolated centre offset s -> edge distance d, both in cells, increasing
+  std::vector<double> df_s_, df_d_;
+
+  // output of the updated pass
+  std::vector<std::pair<int, int>> pairs_;
+  std::vector<Vec3> pair_force_;
+  std::vector<int> pair_index_;  ///< n_fields^2 -> index into pairs_
+  std::size_t active_ = 0;
+};
+
+}  // namespace cairn

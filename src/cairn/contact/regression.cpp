@@ -1,0 +1,222 @@
+// Logistic / linear regression plane fits of seed 004 (../shared/seeds/004_29fd5dcef9cf8d62.txt)
+// Sec. 3.1 and Appendix; see regression.hpp for the contract.
+//
+// Notation (cell units, see the header): u_p = ((X_p - center) / dx, 1) is the augmented position
+// of Eq. 19, phi = (phi_n, phi_4). For the logistic model the Gauss-Newton update of Eq. 21 is
+//   phi <- phi + (J^T W J + Lambda)^{-1} (J^T W (c - f) - Lambda phi)
+// with J_pj = psi(u_p) u_pj and psi = 2 e^{-z} / (1 + e^{-z})^2, z = u_p.phi (Eq. 53), so that
+//   (J^T W J + Lambda)_kl = lambda_k delta_kl + sum_p psi_p^2 w_p u_pk u_pl         (Eq. 54-55)
+//   (J^T W (c - f) - Lambda phi)_j = -lambda_j phi_j + sum_p psi_p w_p (c_p - f_p) u_pj (Eq. 56).
+// At phi = 0: f = 0 and psi = 1/2, so the first update is
+//   phi^(1) = 2 (U^T W U + 4 Lambda)^{-1} U^T W c,
+// i.e. the linear regression phi_lin = (U^T W U + Lambda)^{-1} U^T W c up to the factor 2 and a
+// fourfold penalty: with the Appendix penalty (1e-7 in cell units) the two directions agree to
+// ~1e-7, and exactly without penalty (the Appendix's "first iteration is equivalent to linear
+// regression"). The iterations are templated on the dimension so that every matrix is a fixed
+// (D+1)x(D+1) Eigen object: no heap allocation inside a fit.
+#include "cairn/contact/regression.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+namespace cairn::contact {
+namespace {
+
+/// Smallest LDLT pivot, relative to the largest, for which a normal matrix counts as regular.
+constexpr double kMinPivotRatio = 1e-14;
+
+template <int D>
+struct Fitter {
+  static constexpr int K = D + 1;
+  using VecK = Eigen::Matrix<double, K, 1>;
+  using MatK = Eigen::Matrix<double, K, K>;
+
+  std::span<const Vec3> x;
+  std::span<const signed char> cls;
+  std::span<const double> w;
+  Vec3 center;
+  double inv_h = 1.0;
+  VecK lambda;  // diagonal of Lambda in cell units: (penalty, ..., penalty, 0)
+
+  VecK local(std::size_t p) const {
+    VecK u;
+    u.template head<D>() = (x[p].template head<D>() - center.template head<D>()) * inv_h;
+    u(D) = 1.0;
+    return u;
+  }
+  double weight(std::size_t p) const { return w.empty() ? 1.0 : w[p]; }
+
+  /// Solve a (D+1) normal system by LDLT; false when (numerically) singular.
+  static bool solve(const MatK& a, const VecK& b, VecK& out) {
+    const Eigen::LDLT<MatK> ldlt(a);
+    if (ldlt.info() != Eigen::Success) return false;
+    // Cheap singularity test on the pivots (the normal matrix is symmetric positive
+    // semi-definite): the smallest pivot must be positive and not negligible next to the largest.
+    const VecK d = ldlt.vectorD();
+    if (!(d.minCoeff() > kMinPivotRatio * d.cwiseAbs().maxCoeff())) return false;
+    out = ldlt.solve(b);
+    return out.allFinite();
+  }
+
+  /// Linear least squares with f = u.phi: (U^T W U + Lambda) phi = U^T W c (Appendix).
+  bool linear(VecK& phi) const {
+    MatK a = lambda.asDiagonal();
+    VecK b = VecK::Zero();
+    for (std::size_t p = 0; p < x.size(); ++p) {
+      if (cls[p] == 0) continue;
+      const double c = cls[p] > 0 ? 1.0 : -1.0;
+      const VecK u = local(p);
+      const double wp = weight(p);
+      a.noalias() += (wp * u) * u.transpose();
+      b += (wp * c) * u;
+    }
+    return solve(a, b, phi);
+  }
+
+  /// One Gauss-Newton update of the logistic model (Eq. 21 with Eq. 53-56), in place.
+  bool gauss_newton(VecK& phi) const {
+    MatK a = lambda.asDiagonal();
+    VecK b = -lambda.cwiseProduct(phi);
+    for (std::size_t p = 0; p < x.size(); ++p) {
+      if (cls[p] == 0) continue;
+      const double c = cls[p] > 0 ? 1.0 : -1.0;
+      const VecK u = local(p);
+      const double wp = weight(p);
+      // Overflow-free logistic: with e = exp(-|z|) in (0, 1],
+      //   f = sign(z) (1 - e) / (1 + e),  psi = 2 e / (1 + e)^2 (psi is even in z).
+      // exp only sees non-positive arguments, so nothing can overflow; for |z| > ~745 e
+      // underflows to 0, giving f = +-1 and psi = 0 exactly as in the limit.
+      const double z = u.dot(phi);
+      const double e = std::exp(-std::abs(z));
+      const double f = std::copysign((1.0 - e) / (1.0 + e), z);
+      const double psi = 2.0 * e / ((1.0 + e) * (1.0 + e));
+      a.noalias() += ((psi * psi * wp) * u) * u.transpose();
+      b += (psi * wp * (c - f)) * u;
+    }
+    VecK step;
+    if (!solve(a, b, step)) return false;
+    phi += step;
+    return true;
+  }
+
+  /// Unit normal part of phi (zero vector when phi_n = 0).
+  static Eigen::Matrix<double, D, 1> unit_normal(const VecK& phi) {
+    const double n = phi.template head<D>().norm();
+    if (!(n > 0.0) || !std::isfinite(n)) return Eigen::Matrix<double, D, 1>::Zero();
+    return phi.template head<D>() / n;
+  }
+};
+
+template <int D>
+PlaneFit fit_impl(std::span<const Vec3> x, std::span<const signed char> cls,
+                  std::span<const double> w, const Vec3& center, const PlaneFitOptions& opt,
+                  PlaneFitMethod method, const Vec3* initial_normal) {
+  using F = Fitter<D>;
+  using VecK = typename F::VecK;
+  PlaneFit out;
+
+  const double h = opt.cell_size > 0.0 ? opt.cell_size : 1.0;  // guard: non-positive -> 1
+  F fit{x, cls, w, center, 1.0 / h, VecK::Zero()};
+
+  // Both classes must be present (with positive total weight), or there is nothing to separate.
+  double w_alpha = 0.0, w_beta = 0.0;
+  for (std::size_t p = 0; p < x.size(); ++p) {
+    if (cls[p] < 0) w_alpha += fit.weight(p);
+    if (cls[p] > 0) w_beta += fit.weight(p);
+  }
+  if (!(w_alpha > 0.0) || !(w_beta > 0.0)) return out;
+  // lambda = penalty dx^2 (1,1,1,0) in physical units is penalty (1,1,1,0) in cell units, because
+  // phi_n(cell) = dx phi_n(physical) (see the header).
+  fit.lambda.template head<D>().setConstant(opt.penalty);
+  fit.lambda(D) = 0.0;
+
+  VecK phi = VecK::Zero();
+  // `linear`: one solve. `logistic`: the first Gauss-Newton step from phi^(0) = 0, which is the
+  // linear regression up to scale (Appendix; see the top of this file). It is run as a logistic
+  // step so that the iterates follow Eq. 21 exactly.
+  const bool first_ok = method == PlaneFitMethod::linear ? fit.linear(phi) : fit.gauss_newton(phi);
+  if (!first_ok) return out;
+  Eigen::Matrix<double, D, 1> n_prev = F::unit_normal(phi);
+  if (n_prev.isZero(0.0)) return out;
+  int iterations = 1;
+  bool converged = method == PlaneFitMethod::linear;
+
+  if (method == PlaneFitMethod::logistic) {
+    if (initial_normal != nullptr) {
+      const Eigen::Matrix<double, D, 1> n0 = initial_normal->template head<D>();
+      const double len = n0.norm();
+      if (len > 0.0 && std::isfinite(len)) {
+        // Warm start: keep the scale |phi_n| of the first step, take the given direction, and
+        // the offset minimising sum_p w_p (m u_p.n0 + phi_4 - c_p)^2 along it.
+        const double m = phi.template head<D>().norm();
+        const Eigen::Matrix<double, D, 1> dir = n0 / len;
+        double num = 0.0, den = 0.0;
+        for (std::size_t p = 0; p < x.size(); ++p) {
+          if (cls[p] == 0) continue;
+          const double wp = fit.weight(p);
+          const double c = cls[p] > 0 ? 1.0 : -1.0;
+          num += wp * (c - m * fit.local(p).template head<D>().dot(dir));
+          den += wp;
+        }
+        phi.template head<D>() = m * dir;
+        phi(D) = num / den;
+        n_prev = dir;
+      }
+    }
+
+    const int max_it = opt.max_iterations > 0 ? opt.max_iterations : 1;
+    while (iterations < max_it) {
+      VecK next = phi;
+      if (!fit.gauss_newton(next)) break;  // keep the last good iterate
+      const Eigen::Matrix<double, D, 1> n_next = F::unit_normal(next);
+      if (n_next.isZero(0.0)) break;
+      phi = next;
+      ++iterations;
+      const double change = 1.0 - n_prev.dot(n_next);  // Eq. 57
+      n_prev = n_next;
+      if (change < opt.tolerance) {
+        converged = true;
+        break;
+      }
+    }
+  }
+
+  // Back to physical coordinates: the plane u.phi_n + phi_4 = 0 with u = (x - center)/dx is
+  // (x - center).n_hat + phi_4 dx / |phi_n| = 0.
+  const double len = phi.template head<D>().norm();
+  out.normal.template head<D>() = phi.template head<D>() / len;
+  out.offset = phi(D) * h / len - center.template head<D>().dot(out.normal.template head<D>());
+  out.iterations = iterations;
+  out.converged = converged;
+  out.ok = out.normal.allFinite() && std::isfinite(out.offset);
+  if (!out.ok) out = PlaneFit{};
+  return out;
+}
+
+}  // namespace
+
+PlaneFit fit_separating_plane(std::span<const Vec3> x, std::span<const signed char> cls,
+                              std::span<const double> w, const Vec3& center,
+                              const PlaneFitOptions& opt, PlaneFitMethod method,
+                              const Vec3* initial_normal) {
+  if (cls.size() != x.size() || (!w.empty() && w.size() != x.size())) return {};
+  switch (opt.dim) {
+    case 1: return fit_impl<1>(x, cls, w, center, opt, method, initial_normal);
+    case 2: return fit_impl<2>(x, cls, w, center, opt, method, initial_normal);
+    case 3: return fit_impl<3>(x, cls, w, center, opt, method, initial_normal);
+    default: return {};
+  }
+}
+
+double deformed_radius(const Mat3& F, const Vec3& R0, const Vec3& n, int dim) {
+  // Eq. 25: n0 = F^{-1} n is n pulled back to the initial configuration (not a unit vector).
+  const Vec3 n0 = F.inverse() * n;
+  const int d = dim < 1 ? 1 : (dim > 3 ? 3 : dim);
+  double s = 0.0;
+  for (int a = 0; a < d; ++a) s += (n0(a) * n0(a)) / (R0(a) * R0(a));
+  if (s == 0.0) return std::numeric_limits<double>::infinity();
+  return 1.0 / std::sqrt(s);
+}
+
+}  // namespace cairn::contact

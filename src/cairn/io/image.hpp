@@ -1,0 +1,41 @@
+// Grey-level images for bodies drawn as pictures ([[body]] shape `image`, seed 004 Sec. 4.2:
+// a bitmap whose pixel shades mark different materials becomes particles).
+//
+// read_png_grey() reads any PNG (grey, grey+alpha, palette, RGB, RGBA; 1 to 16 bits per
+// channel, interlaced or not) as 8-bit grey levels 0..255:
+//   - palette entries and grey depths below 8 bits are expanded to 8 bits;
+//   - colour becomes luma 0.2126 R + 0.7152 G + 0.0722 B (Rec. 709 weights, on the stored,
+//     gamma-encoded values; a pixel with R = G = B keeps that value exactly);
+//   - 16-bit samples are scaled to 8 bits (round(v * 255 / 65535));
+//   - alpha (and tRNS transparency) is ignored.
+// Rows are stored as in the file: row 0 is the TOP row of the picture.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cairn {
+
+struct GreyImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> level;  ///< width * height grey levels, row by row from the top
+
+  /// Grey level of column `col` (0 = left) in row `row` (0 = top).
+  [[nodiscard]] std::uint8_t at(int col, int row) const {
+    return level[static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
+                 static_cast<std::size_t>(col)];
+  }
+};
+
+/// The image in `path` as 8-bit grey levels. Throws std::invalid_argument naming the path and
+/// the reason (cannot open, not a PNG file, libpng's error message) on failure.
+GreyImage read_png_grey(const std::string& path);
+
+/// Where an image named in an input file lies: `file` itself when absolute, else `file` relative
+/// to the directory of `input_file` (the current directory when input_file has none), made
+/// absolute and lexically normal so that it stays valid wherever the resolved input is read.
+std::string resolve_input_relative(const std::string& file, const std::string& input_file);
+
+}  // namespace cairn

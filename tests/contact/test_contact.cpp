@@ -1,0 +1,199 @@
+// Multimaterial contact (contact/contact.hpp, contact/law.hpp; seed 004).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "../support/config_builder.hpp"
+#include "cairn/contact/law.hpp"
+#include "cairn/sim/simulation.hpp"
+
+namespace cairn {
+namespace {
+
+ContactInput approaching(double tangential) {
+  ContactInput in;
+  in.normal = Vec3(0.0, 1.0, 0.0);
+  in.dp0 = Vec3(tangential, -2.0, 0.0);  // beta approaches alpha: dp0.n < 0
+  in.reduced_mass = 0.5;
+  in.area = 0.1;
+  in.dt = 0.01;
+  return in;
+}
+
+TEST(ContactLaws, FrictionlessKeepsOnlyTheNormalChange) {
+  auto law = make_contact_law(ContactLawConfig{"frictionless", 0.0, -1.0, "0"}, {});
+  const Vec3 dp = law->momentum_change(approaching(1.5));
+  EXPECT_DOUBLE_EQ(dp[0], 0.0);
+  EXPECT_DOUBLE_EQ(dp[1], -2.0);
+  EXPECT_FALSE(law->bonded());
+}
+
+TEST(ContactLaws, CoulombSticksBelowMuNAndSlidesAtMuDynamicNAbove) {
+  // N_c A dt = -dp0.n = 2; stick needs |dp0_t| <= mu_s * 2.
+  auto law = make_contact_law(ContactLawConfig{"coulomb", 0.5, 0.25, "0"}, {});
+  const Vec3 stick = law->momentum_change(approaching(0.9));
+  EXPECT_DOUBLE_EQ(stick[0], 0.9);
+  const Vec3 slide = law->momentum_change(approaching(1.5));
+  EXPECT_NEAR(slide[0], 0.25 * 2.0, 1e-14);  // mu_d N A dt along t, t along +x (dp0.t > 0)
+  EXPECT_DOUBLE_EQ(slide[1], -2.0);
+  const Vec3 back = law->momentum_change(approaching(-1.5));
+  EXPECT_NEAR(back[0], -0.5, 1e-14);  // t follows the tangential part of dp0
+}
+
+TEST(ContactLaws, GeneralLawWithMuNcMatchesCoulombAndIsCappedAtStick) {
+  auto general = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "0.25*Nc"}, {});
+  auto coulomb = make_contact_law(ContactLawConfig{"coulomb", 0.25, -1.0, "0"}, {});
+  for (double t : {0.1, 0.4, 1.5, -3.0}) {
+    const Vec3 a = general->momentum_change(approaching(t)), b = coulomb->momentum_change(approaching(t));
+    EXPECT_NEAR((a - b).norm(), 0.0, 1e-13) << t;
+  }
+  // A slide expression using the slip speed: 10 * vslip with vslip = |dp0_t| / m_red.
+  // vslip = 0.01 / 0.5 = 0.02: S = 0.2, S A dt = 2e-4 < 0.01 slides; 1e4 vslip would stick.
+  auto viscous = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "10*vslip"}, {});
+  const ContactInput in = approaching(0.01);
+  EXPECT_NEAR(viscous->momentum_change(in)[0], 2e-4, 1e-15);
+  auto stiff = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "1e4*vslip"}, {});
+  EXPECT_NEAR(stiff->momentum_change(in)[0], 0.01, 1e-15);
+  EXPECT_THROW(make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "2*bogus"}, {}), std::invalid_argument);
+}
+
+TEST(ContactLaws, PerfectIsBondedAndUnknownNamesAreListed) {
+  auto perfect = make_contact_law(ContactLawConfig{"perfect", 0.0, -1.0, "0"}, {});
+  EXPECT_TRUE(perfect->bonded());
+  try {
+    (void)make_contact_law(ContactLawConfig{"glue", 0.0, -1.0, "0"}, {});
+    FAIL() << "no error";
+  } catch (const UnknownName& e) {
+    EXPECT_NE(std::string(e.what()).find("coulomb"), std::string::npos);
+  }
+}
+
+/// Two boxes of two materials with identical properties side by side (x < 0.5 and x > 0.5).
+Config split_block(const std::string& update, int order, const std::string& law) {
+  Config c = test::box_config(2, "bspline2", "neo_hookean");
+  c.method.update = update;
+  c.method.order = order;
+  c.simulation.cfl = 0.3;
+  MaterialConfig second = c.materials[0];
+  second.name = "mat2";
+  c.materials.push_back(second);
+  BodyConfig right = c.bodies[0];
+  c.bodies[0].shape.max = {0.5, 0.7};
+  c.bodies[0].velocity = {"0.3*sin(3*y)", "-0.2*x"};
+  right.name = "right";
+  right.material = law.empty() ? "mat" : "mat2";
+  right.shape.min = {0.5, 0.3};
+  right.velocity = c.bodies[0].velocity;
+  c.bodies.push_back(right);
+  if (!law.empty()) {
+    c.contact.mode = "material";
+    c.contact.law.law = law;
+  }
+  return c;
+}
+
+template <int D>
+double max_stress_difference(const Simulation<D>& a, const Simulation<D>& b) {
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t p = 0; p < a.particles().n(); ++p) {
+    worst = std::max(worst, (a.particles().kirchhoff_stress[p] - b.particles().kirchhoff_stress[p]).norm());
+    scale = std::max(scale, a.particles().kirchhoff_stress[p].norm());
+  }
+  return worst / scale;
+}
+
+TEST(Contact, PerfectInterfaceUnderFlipIsSingleMaterialToRoundOff) {
+  // seed 004 Sec. 3.2: with two corrections per step and a^a = (v^a+ - v^a) / dt, a perfect
+  // interface reverts to single-material MPM.
+  Simulation<2> single(split_block("flip", 1, ""));
+  Simulation<2> multi(split_block("flip", 1, "perfect"));
+  ASSERT_NE(multi.contact(), nullptr);
+  EXPECT_EQ(single.contact(), nullptr);
+  for (int k = 0; k < 25; ++k) {
+    const double dt = single.next_dt();
+    single.step(dt);
+    multi.step(dt);
+  }
+  EXPECT_GT(multi.contact()->contact_nodes(), 0u);
+  EXPECT_LT(max_stress_difference(single, multi), 1e-11);
+  for (std::size_t p = 0; p < single.particles().n(); ++p)
+    ASSERT_LT((single.particles().velocity[p] - multi.particles().velocity[p]).norm(), 1e-12);
+}
+
+TEST(Contact, OnceCorrectionDoesNotRevertToSingleMaterial) {
+  Config once = split_block("flip", 1, "perfect");
+  once.contact.corrections = "once";
+  Simulation<2> single(split_block("flip", 1, "")), multi(once);
+  for (int k = 0; k < 25; ++k) {
+    const double dt = single.next_dt();
+    single.step(dt);
+    multi.step(dt);
+  }
+  EXPECT_GT(max_stress_difference(single, multi), 1e-6);  // Sec. 4.1 "LR Once"
+}
+
+TEST(Contact, MultimaterialXpicWithTheDvTermStaysCloserToSingleMaterialThanWithout) {
+  // seed 004 Eq. 45-48: corrected multimaterial XPIC(m) differs from single material by a term
+  // in V - S v; the uncorrected one by a term in S v, which is larger.
+  Simulation<2> single(split_block("xpic", 4, ""));
+  Simulation<2> corrected(split_block("xpic", 4, "perfect"));
+  Config u = split_block("xpic", 4, "perfect");
+  u.contact.xpic_correction = false;
+  Simulation<2> uncorrected(u);
+  for (int k = 0; k < 25; ++k) {
+    const double dt = single.next_dt();
+    single.step(dt);
+    corrected.step(dt);
+    uncorrected.step(dt);
+  }
+  const double dc = max_stress_difference(single, corrected), du = max_stress_difference(single, uncorrected);
+  EXPECT_LT(dc, 0.5 * du) << dc << " " << du;
+}
+
+TEST(Contact, FrictionlessImpactConservesMomentumAndTheFieldsSeparate) {
+  for (const char* detection : {"lr", "velocity", "cp", "df"}) {
+    Config c = test::box_config(2, "gimp", "neo_hookean");
+    c.simulation.cfl = 0.3;
+    c.bodies[0].shape.min = {0.1, 0.3};
+    c.bodies[0].shape.max = {0.4, 0.7};
+    c.bodies[0].velocity = {"0.5", "0.0"};
+    BodyConfig right = c.bodies[0];
+    right.name = "right";
+    right.shape.min = {0.6, 0.3};
+    right.shape.max = {0.9, 0.7};
+    right.velocity = {"-0.5", "0.0"};
+    c.bodies.push_back(right);
+    c.contact.mode = "body";
+    c.contact.detection = detection;
+    c.contact.normal = "ag";
+    Simulation<2> sim(c);
+    double initial = 0.0;
+    for (std::size_t p = 0; p < sim.particles().n(); ++p) initial += sim.particles().mass[p] * std::abs(sim.particles().velocity[p][0]);
+    bool touched = false;
+    while (sim.time() < 0.3) {
+      sim.step(sim.next_dt());
+      touched = touched || sim.contact()->active_nodes() > 0;
+      ASSERT_LT(std::abs(sim.totals().momentum[0]), 1e-10 * initial) << detection;
+    }
+    EXPECT_TRUE(touched) << detection;
+    // After the bounce the left body moves left and the right body right.
+    double vl = 0.0, vr = 0.0, ml = 0.0, mr = 0.0;
+    for (std::size_t p = 0; p < sim.particles().n(); ++p) {
+      const double m = sim.particles().mass[p];
+      (sim.particles().body[p] == 0 ? vl : vr) += m * sim.particles().velocity[p][0];
+      (sim.particles().body[p] == 0 ? ml : mr) += m;
+    }
+    EXPECT_LT(vl / ml, -0.1) << detection;
+    EXPECT_GT(vr / mr, 0.1) << detection;
+  }
+}
+
+TEST(Contact, SingleFieldRunsKeepOneEntryPerNode) {
+  Simulation<2> single(split_block("flip", 1, ""));
+  EXPECT_EQ(single.nodes().mass.size(), static_cast<std::size_t>(single.grid().n_nodes()));
+  Simulation<2> multi(split_block("flip", 1, "perfect"));
+  EXPECT_EQ(multi.nodes().mass.size(), 2u * static_cast<std::size_t>(multi.grid().n_nodes()));
+}
+
+}  // namespace
+}  // namespace cairn
