@@ -56,6 +56,13 @@ void print_summary(const cairn::RunSummary& s) {
     line.pop_back();
     fmt::print("{}\n", line);
   }
+  if (s.contact_node_steps > 0) {
+    const double c = s.contact_prepare_seconds + s.contact_correct_seconds;
+    fmt::print("cairn: contact {:.3f} s ({:.0f}% of the stages; normals and separations {:.3f} s, "
+               "corrections {:.3f} s) over {} contact-node steps: {:.3g} us per contact node\n",
+               c, total > 0.0 ? 100.0 * c / total : 0.0, s.contact_fit_seconds, s.contact_correct_seconds,
+               s.contact_node_steps, 1e6 * c / static_cast<double>(s.contact_node_steps));
+  }
 }
 
 }  // namespace

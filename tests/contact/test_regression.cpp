@@ -486,11 +486,35 @@ TEST(RegressionPlaneFit, OneClassOrBadInputIsNotOk) {
   for (double y : {0.25, 0.75}) line.add(Vec3(0.5, y, 0.0), 1);
   PlaneFitOptions no_penalty = opt;
   no_penalty.penalty = 0.0;
+  no_penalty.flat_extent = 0.0;  // the flat-cloud guard would regularise it too
   for (auto m : {PlaneFitMethod::linear, PlaneFitMethod::logistic})
     EXPECT_FALSE(fit(line, node, no_penalty, m).ok);
   const PlaneFit reg = fit(line, node, opt, PlaneFitMethod::logistic);
   ASSERT_TRUE(reg.ok);
   EXPECT_LT(angle_between(reg.normal, Vec3::UnitY()), 1e-3);
+  PlaneFitOptions guard_only = no_penalty;
+  guard_only.flat_extent = 0.03;
+  EXPECT_TRUE(fit(line, node, guard_only, PlaneFitMethod::logistic).ok);
+}
+
+TEST(RegressionPlaneFit, FlatCloudGuardKeepsTheNormalAlongTheRow) {
+  // One row of particles next to a node beyond a body's edge (the row y ~ 1.25 cells), alpha on
+  // the left and beta on the right, with 1e-3-cell position noise that happens to correlate with
+  // the class. The normal must be along the row (x), not across it.
+  Cloud row;
+  const double xs[] = {-1.186, -0.686, -0.187, 0.298, 0.772, 1.228};
+  const double ys[] = {1.24994, 1.24973, 1.2494, 1.24908, 1.24878, 1.24878};
+  for (int k = 0; k < 6; ++k) row.add(Vec3(xs[k], ys[k], 0.0), k < 5 ? -1 : 1);
+  PlaneFitOptions opt;
+  opt.dim = 2;
+  const Vec3 node = Vec3::Zero();
+  const PlaneFit guarded = fit(row, node, opt, PlaneFitMethod::logistic);
+  ASSERT_TRUE(guarded.ok);
+  EXPECT_LT(angle_between(guarded.normal, Vec3::UnitX()), 0.05);
+  PlaneFitOptions off = opt;
+  off.flat_extent = 0.0;
+  const PlaneFit unguarded = fit(row, node, off, PlaneFitMethod::logistic);
+  EXPECT_GT(angle_between(unguarded.normal, Vec3::UnitX()), 0.5);  // what the guard prevents
 }
 
 TEST(RegressionPlaneFit, OneDimensionalFit) {

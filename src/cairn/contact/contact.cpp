@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -181,6 +182,12 @@ double Contact<D>::edge_distance(double s) const {
 
 template <int D>
 void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& cache, const std::vector<double>& mass) {
+  const auto t0 = std::chrono::steady_clock::now();
+  struct Lap {
+    std::chrono::steady_clock::time_point start;
+    double& total;
+    ~Lap() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+  } lap{t0, prepare_seconds_};
   const int nf = n_fields();
   // Contact nodes: two or more fields with mass.
   for (std::int32_t c : nodes_) contact_of_[static_cast<std::size_t>(c)] = -1;
@@ -223,6 +230,7 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     }
     inter_begin_.push_back(static_cast<std::int32_t>(inter_.size()));
   }
+  node_steps_ += static_cast<long long>(nc);
   if (nc == 0) return;
 
   const std::size_t n_slots = static_cast<std::size_t>(nf) * static_cast<std::size_t>(n_nodes_);
@@ -266,6 +274,8 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     }
   }
   // Normals and separations, node by node.
+  const auto t_fit = std::chrono::steady_clock::now();
+  Lap fit_lap{t_fit, fit_seconds_};
   const auto n_contact = static_cast<std::int64_t>(nc);
 #pragma omp parallel
   {
@@ -401,6 +411,12 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
                          double time, double dt, std::vector<Vec<D>>* dv) {
   const std::size_t nc = nodes_.size();
   const bool record = pass == Pass::updated;
+  const auto t0 = std::chrono::steady_clock::now();
+  struct Lap {
+    std::chrono::steady_clock::time_point start;
+    double& total;
+    ~Lap() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+  } lap{t0, correct_seconds_};
   if (record) {
     active_ = 0;
     for (auto& f : pair_force_) f.setZero();

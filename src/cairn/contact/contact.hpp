@@ -63,6 +63,12 @@ class Contact {
   /// Unit contact normal per grid node (zero away from contact nodes), for grid snapshots.
   void node_normals(std::vector<Vec3>& out) const;
   [[nodiscard]] bool corrects_extrapolation() const { return twice_; }
+  /// Cost counters: seconds in prepare (contact nodes, clouds, normals, separations), of which
+  /// in the normal and separation fits, seconds in correct, and contact nodes summed over steps.
+  [[nodiscard]] double prepare_seconds() const { return prepare_seconds_; }
+  [[nodiscard]] double fit_seconds() const { return fit_seconds_; }
+  [[nodiscard]] double correct_seconds() const { return correct_seconds_; }
+  [[nodiscard]] long long node_steps() const { return node_steps_; }
   [[nodiscard]] bool xpic_correction() const { return xpic_correction_; }
 
  private:
@@ -114,6 +120,8 @@ class Contact {
   std::vector<Vec3> pair_force_;
   std::vector<int> pair_index_;  ///< n_fields^2 -> index into pairs_
   std::size_t active_ = 0;
+  double prepare_seconds_ = 0.0, fit_seconds_ = 0.0, correct_seconds_ = 0.0;
+  long long node_steps_ = 0;
 };
 
 }  // namespace cairn

@@ -20,6 +20,8 @@
 #include <cstddef>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 namespace cairn::contact {
 namespace {
 
@@ -37,7 +39,7 @@ struct Fitter {
   std::span<const double> w;
   Vec3 center;
   double inv_h = 1.0;
-  VecK lambda;  // diagonal of Lambda in cell units: (penalty, ..., penalty, 0)
+  MatK lambda;  // Lambda in cell units: diag(penalty, ..., penalty, 0) plus the flat-cloud guard
 
   VecK local(std::size_t p) const {
     VecK u;
@@ -61,7 +63,7 @@ struct Fitter {
 
   /// Linear least squares with f = u.phi: (U^T W U + Lambda) phi = U^T W c (Appendix).
   bool linear(VecK& phi) const {
-    MatK a = lambda.asDiagonal();
+    MatK a = lambda;
     VecK b = VecK::Zero();
     for (std::size_t p = 0; p < x.size(); ++p) {
       if (cls[p] == 0) continue;
@@ -76,8 +78,8 @@ struct Fitter {
 
   /// One Gauss-Newton update of the logistic model (Eq. 21 with Eq. 53-56), in place.
   bool gauss_newton(VecK& phi) const {
-    MatK a = lambda.asDiagonal();
-    VecK b = -lambda.cwiseProduct(phi);
+    MatK a = lambda;
+    VecK b = -(lambda * phi);
     for (std::size_t p = 0; p < x.size(); ++p) {
       if (cls[p] == 0) continue;
       const double c = cls[p] > 0 ? 1.0 : -1.0;
@@ -117,7 +119,7 @@ PlaneFit fit_impl(std::span<const Vec3> x, std::span<const signed char> cls,
   PlaneFit out;
 
   const double h = opt.cell_size > 0.0 ? opt.cell_size : 1.0;  // guard: non-positive -> 1
-  F fit{x, cls, w, center, 1.0 / h, VecK::Zero()};
+  F fit{x, cls, w, center, 1.0 / h, F::MatK::Zero()};
 
   // Both classes must be present (with positive total weight), or there is nothing to separate.
   double w_alpha = 0.0, w_beta = 0.0;
@@ -128,8 +130,36 @@ PlaneFit fit_impl(std::span<const Vec3> x, std::span<const signed char> cls,
   if (!(w_alpha > 0.0) || !(w_beta > 0.0)) return out;
   // lambda = penalty dx^2 (1,1,1,0) in physical units is penalty (1,1,1,0) in cell units, because
   // phi_n(cell) = dx phi_n(physical) (see the header).
-  fit.lambda.template head<D>().setConstant(opt.penalty);
-  fit.lambda(D) = 0.0;
+  fit.lambda.diagonal().template head<D>().setConstant(opt.penalty);
+  // Flat-cloud guard (Cairn's addition, docs/contact.md): a cloud with (almost) no extent along
+  // some direction e -- one row of particles next to a node beyond a body's edge -- carries no
+  // information about the normal component along e, yet with the Appendix penalty alone the
+  // fit would turn the normal along e to separate the classes by tiny position differences.
+  // Directions whose weighted variance is below opt.flat_extent^2 (cell units) get the penalty
+  // (sum w) e e^T on the normal components, as if the cloud spread one cell that way.
+  if (opt.flat_extent > 0.0) {
+    Eigen::Matrix<double, D, 1> mean = Eigen::Matrix<double, D, 1>::Zero();
+    double sw = 0.0;
+    for (std::size_t p = 0; p < x.size(); ++p) {
+      if (cls[p] == 0) continue;
+      mean += fit.weight(p) * fit.local(p).template head<D>();
+      sw += fit.weight(p);
+    }
+    mean /= sw;
+    Eigen::Matrix<double, D, D> cov = Eigen::Matrix<double, D, D>::Zero();
+    for (std::size_t p = 0; p < x.size(); ++p) {
+      if (cls[p] == 0) continue;
+      const Eigen::Matrix<double, D, 1> d = fit.local(p).template head<D>() - mean;
+      cov.noalias() += fit.weight(p) * d * d.transpose();
+    }
+    cov /= sw;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig(cov);
+    for (int k = 0; k < D; ++k)
+      if (eig.eigenvalues()(k) < opt.flat_extent * opt.flat_extent) {
+        const Eigen::Matrix<double, D, 1> e = eig.eigenvectors().col(k);
+        fit.lambda.template topLeftCorner<D, D>().noalias() += sw * e * e.transpose();
+      }
+  }
 
   VecK phi = VecK::Zero();
   // `linear`: one solve. `logistic`: the first Gauss-Newton step from phi^(0) = 0, which is the

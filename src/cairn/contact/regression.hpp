@@ -24,6 +24,9 @@ struct PlaneFitOptions {
   int dim = 2;              // 1, 2 or 3: components used (2D drops z, phi_3, lambda_3)
   double cell_size = 1.0;   // dx: penalty lambda = 1e-7 dx^2 (1,1,1,0) (Appendix)
   double penalty = 1e-7;    // the 1e-7 factor
+  /// Flat-cloud guard: directions along which the cloud's standard deviation is below this many
+  /// cells get a unit-extent penalty (0 = off; see regression.cpp). Not in seed 004.
+  double flat_extent = 0.03;
   double tolerance = 1e-5;  // stop when 1 - n_k.n_{k+1} < tolerance (Eq. 57)
   int max_iterations = 15;
 };

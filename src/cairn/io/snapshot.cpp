@@ -101,7 +101,8 @@ fs::path SnapshotWriter<D>::grid_xdmf_path() const {
 
 template <int D>
 void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long long step,
-                              const Grid<D>* grid, const NodeField<D>* nodes) {
+                              const Grid<D>* grid, const NodeField<D>* nodes,
+                              const std::vector<Vec3>* contact_normals) {
   const std::size_t n = particles.n();
   const bool with_grid = grid != nullptr && nodes != nullptr;
   if (particles.reference_position.size() != n || particles.velocity.size() != n ||
@@ -149,7 +150,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   FileInfo file_info;
   file_info.readable = true;
   file_info.n_particles = n;
-  std::vector<double> node_mass, node_velocity;
+  std::vector<double> node_mass, node_velocity, node_normal;
   if (with_grid) {
     file_info.has_grid = true;
     file_info.origin.assign(3, 0.0);
@@ -168,6 +169,12 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
     node_velocity.assign(3 * nn, 0.0);
     for (std::size_t i = 0; i < nn; ++i) {
       for (int a = 0; a < D; ++a) node_velocity[3 * i + a] = nodes->velocity_new[i][a];
+    }
+    if (contact_normals && contact_normals->size() == nn) {
+      file_info.has_contact_normal = true;
+      node_normal.assign(3 * nn, 0.0);
+      for (std::size_t i = 0; i < nn; ++i)
+        for (int a = 0; a < 3; ++a) node_normal[3 * i + a] = (*contact_normals)[i][a];
     }
   }
 
@@ -202,6 +209,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       std::vector<std::size_t> vshape = file_info.node_shape;
       vshape.push_back(3);
       h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape);
+      if (file_info.has_contact_normal) h5::write_doubles_shaped(gid, "contact_normal", node_normal.data(), vshape);
       h5::write_doubles_attribute(gid, "origin", file_info.origin);
       h5::write_doubles_attribute(gid, "spacing", file_info.spacing);
     }
@@ -243,6 +251,7 @@ const typename SnapshotWriter<D>::FileInfo& SnapshotWriter<D>::info(const std::s
         fi.origin = h5::read_doubles_attribute(grid.get(), "origin");
         fi.spacing = h5::read_doubles_attribute(grid.get(), "spacing");
         fi.has_grid = fi.origin.size() == 3 && fi.spacing.size() == 3;
+        fi.has_contact_normal = h5::has_child(grid.get(), "contact_normal");
       }
     } catch (const std::runtime_error&) {
       fi = FileInfo{};  // unreadable: left out of the XDMF listing
@@ -318,6 +327,8 @@ void SnapshotWriter<D>::write_xdmf() {
                    origin, rank, spacing);
     attribute(grids, "node_mass", "Scalar", dims, false, file, "/grid/node_mass");
     attribute(grids, "node_velocity", "Vector", dims + " 3", false, file, "/grid/node_velocity");
+    if (fi.has_contact_normal)
+      attribute(grids, "contact_normal", "Vector", dims + " 3", false, file, "/grid/contact_normal");
     grids.append(std::string_view("      </Grid>\n"));
   }
   const std::string_view footer("    </Grid>\n  </Domain>\n</Xdmf>\n");

@@ -46,9 +46,12 @@ class SnapshotWriter {
   /// Write snapshot number next_index() of `particles` at `time`/`step` and rewrite the XDMF
   /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
   /// (node_velocity is NodeField::velocity_new, the grid velocity after the last update).
+  /// `contact_normals` (multimaterial runs, one per node, zero away from contact nodes) adds
+  /// /grid/contact_normal.
   /// Throws std::runtime_error on I/O failure, std::invalid_argument on inconsistent sizes.
   void write(const Particles<D>& particles, double time, long long step,
-             const Grid<D>* grid = nullptr, const NodeField<D>* nodes = nullptr);
+             const Grid<D>* grid = nullptr, const NodeField<D>* nodes = nullptr,
+             const std::vector<Vec3>* contact_normals = nullptr);
 
   /// Index the next write() uses in its file name.
   [[nodiscard]] int next_index() const { return next_index_; }
@@ -74,6 +77,7 @@ class SnapshotWriter {
     bool readable = false;
     std::size_t n_particles = 0;
     bool has_grid = false;
+    bool has_contact_normal = false;
     std::vector<std::size_t> node_shape;  ///< grid node array shape, slowest axis first
     std::vector<double> origin, spacing;  ///< x y z
   };

@@ -147,6 +147,12 @@ class Runner {
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
     summary.stage_seconds = sim_.stage_times();
+    if (const auto* c = sim_.contact()) {
+      summary.contact_prepare_seconds = c->prepare_seconds();
+      summary.contact_fit_seconds = c->fit_seconds();
+      summary.contact_correct_seconds = c->correct_seconds();
+      summary.contact_node_steps = c->node_steps();
+    }
     return summary;
   }
 
@@ -186,7 +192,10 @@ class Runner {
     if (config_.output.grid_snapshots)
     {
       const NodeField<D> nodes = sim_.grid_totals();
-      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &nodes);
+      std::vector<Vec3> normals;
+      if (sim_.contact()) sim_.contact()->node_normals(normals);
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &nodes,
+                       sim_.contact() ? &normals : nullptr);
     }
     else
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());

@@ -24,6 +24,10 @@ struct RunSummary {
   std::filesystem::path last_checkpoint;
   /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).
   std::vector<std::pair<std::string, double>> stage_seconds;
+  /// Multimaterial runs: seconds in contact preparation (of which normal/separation fits) and
+  /// corrections (inside the stages above), and contact nodes summed over the steps.
+  double contact_prepare_seconds = 0.0, contact_fit_seconds = 0.0, contact_correct_seconds = 0.0;
+  long long contact_node_steps = 0;
 };
 
 /// A run stopped by a SimulationFailure, with the step and time at which it happened. The last
