@@ -18,9 +18,6 @@ std::vector<std::string> face_conditions() { return {"free", "fixed", "symmetry"
 std::vector<std::string> boundary_acceleration_names() { return {"zero", "velocity_change"}; }
 std::vector<std::string> face_names_list() { return {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}; }
 std::vector<std::string> axis_names() { return {"x", "y", "z"}; }
-std::vector<std::string> contact_law_names() {
-  return {"perfect", "stick", "frictionless", "coulomb", "general"};
-}
 std::vector<std::string> mode_names() { return {"plane_strain", "plane_stress", "3d", "uniaxial"}; }
 
 /// Fluent construction of a KeyDecl (designated initializers that skip members warn under -Wextra).

@@ -11,5 +11,6 @@ std::vector<std::string> shape_family_names();
 std::vector<std::string> update_scheme_names();
 std::vector<std::string> stress_update_names();
 std::vector<std::string> material_model_names();
+std::vector<std::string> contact_law_names();
 
 }  // namespace cairn
