@@ -105,22 +105,39 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   const Vec<D> h = grid.cell_size();
   const Vec<D> inv_h = h.cwiseInverse();
 
-  // Pass 1: the largest node box of this step sets the cache stride.
+  // The cache stride must hold the largest node box of the step. Reuse the stride of the last
+  // step when the cache already has one for these particles; a particle whose box does not fit
+  // sends the build through the sizing pass and a second try (rare: the stride only grows).
   int slots = 1, widest = 1;
-#pragma omp parallel for reduction(max : slots, widest) schedule(static)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const IVec<D> dims = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims;
-    slots = std::max(slots, dims.prod());
-    widest = std::max(widest, dims.maxCoeff());
+  bool sized = !(cache.stride > 0 && cache.count.size() == particles.n());
+  if (!sized) {
+    slots = cache.stride;
+    widest = cache.stride;
   }
-  cache.reserve(particles.n(), slots);
-
   std::int64_t first_bad = INT64_MAX;
   IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+  for (int attempt = 0; attempt < 2; ++attempt) {
+  if (sized) {
+    // Sizing pass: the largest node box of this step.
+    slots = 1;
+    widest = 1;
+#pragma omp parallel for reduction(max : slots, widest) schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
+      const IVec<D> dims = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims;
+      slots = std::max(slots, dims.prod());
+      widest = std::max(widest, dims.maxCoeff());
+    }
+    cache.reserve(particles.n(), slots);
+  }
+  bool overflow = false;
+  first_bad = INT64_MAX;
+  lo.setZero();
+  hi.setZero();
 #pragma omp parallel
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
+    bool overflow_t = false;
     std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * widest);
     std::array<std::vector<double>, D> w1, dw1;  // fallback weights per axis
     for (int a = 0; a < D; ++a) {
@@ -138,6 +155,10 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       for (int a = 0; a < D; ++a) {
         stride[a] = box;
         box *= dom.dims[a];
+      }
+      if (box > cache.stride || dom.dims.maxCoeff() > widest) {
+        overflow_t = true;  // the reused stride is too small: size and build again
+        continue;
       }
       // Accumulate straight into the particle's cache slots (box order, box <= stride), then
       // compact them in place.
@@ -247,10 +268,14 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     }
 #pragma omp critical
     {
+      overflow = overflow || overflow_t;
       first_bad = std::min(first_bad, bad_t);
       lo = lo.cwiseMax(lo_t);
       hi = hi.cwiseMax(hi_t);
     }
+  }
+  if (!overflow) break;
+  sized = true;
   }
   cache.reach_lo = lo;
   cache.reach_hi = hi;
