@@ -421,10 +421,6 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
     active_ = 0;
     for (auto& f : pair_force_) f.setZero();
   }
-  if (dv)
-    for (std::size_t c = 0; c < nc; ++c)
-      for (int x = field_begin_[c]; x < field_begin_[c + 1]; ++x)
-        (*dv)[static_cast<std::size_t>(fields_[static_cast<std::size_t>(x)] * n_nodes_ + nodes_[c])].setZero();
   const int nf = n_fields();
   constexpr int max_local = 64;
   std::array<Vec3, max_local> p, dp_total;

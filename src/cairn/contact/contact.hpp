@@ -48,7 +48,8 @@ class Contact {
 
   enum class Pass { extrapolated, updated, stress };
   /// Correct `values` (momenta when `momentum`, else velocities; slots) at the contact nodes.
-  /// `dv` (slots), when given, receives dp / m (extrapolated pass). The updated pass records the
+  /// `dv` (slots, zeroed by the caller), when given, receives dp / m at the changed contact
+  /// nodes (extrapolated pass). The updated pass records the
   /// contact forces dp / dt per field pair and the number of nodes in contact.
   void correct(const std::vector<double>& mass, std::vector<Vec<D>>& values, bool momentum, Pass pass,
                double time, double dt, std::vector<Vec<D>>* dv);

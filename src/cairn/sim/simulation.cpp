@@ -316,6 +316,9 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
     // Multimaterial: contact nodes, normals and separations of this step, then the first
     // correction p^a = p^a0 + dp^a kept as dv^a (seed 004 Eq. 26).
     contact_->prepare(particles_, cache_, nodes_.mass);
+    // dv^a is zero wherever this step's first correction does not set it (nodes that were
+    // contact nodes last step included).
+    for_each_node(n_slots(), [&](std::int32_t i) { contact_dv_[i].setZero(); });
     if (contact_->corrects_extrapolation())
       contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, step_dt_,
                         &contact_dv_);
