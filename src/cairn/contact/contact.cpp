@@ -369,7 +369,9 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
       if (cloud_c[k] < 0) max_a = std::max(max_a, xn + R);
       else min_b = std::min(min_b, xn - R);
     }
-    it.separation = min_b - max_a;
+    double hn2 = 0.0;
+    for (int a = 0; a < D; ++a) hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
+    it.separation = min_b - max_a - cfg_.touching_tolerance * std::sqrt(hn2);
   } else {
     // Extrapolated centres x^a, x^b relative to the node (Eq. 11), lumped for beta when needed.
     Vec<D> xa = Vec<D>::Zero(), xb = Vec<D>::Zero();
@@ -400,7 +402,7 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
       const double h = std::sqrt(hn2);
       const double da = edge_distance(sa / h) * h;
       const double db = -edge_distance(-sb / h) * h;
-      it.separation = db - da;
+      it.separation = db - da - cfg_.touching_tolerance * h;
     }
   }
   (void)nf;

@@ -189,6 +189,7 @@ struct ContactConfig {
   std::vector<double> normal_direction;  ///< specified: from the first field to the second
   std::string detection = "lr";     ///< lr | velocity | cp | df
   double critical_separation = 0.8; ///< cp: delta_c in cells (seed 004 Eq. 16)
+  double touching_tolerance = 1e-3; ///< lr/df: touching when the separation < this many cells
   std::string corrections = "twice";///< twice | once (seed 004 Sec. 3.2)
   std::string three_or_more = "lump";  ///< lump (Eq. 50) | pairs
   bool xpic_correction = true;      ///< the Delta v term of multimaterial XPIC/FMPM (Eq. 37)

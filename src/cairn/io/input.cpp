@@ -1383,6 +1383,7 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
   }
   c.detection = r.string("detection");
   c.critical_separation = r.real("critical_separation");
+  c.touching_tolerance = r.real("touching_tolerance");
   c.corrections = r.string("corrections");
   c.three_or_more = r.string("three_or_more");
   c.xpic_correction = r.boolean("xpic_correction");
@@ -1641,6 +1642,7 @@ std::string config_to_toml(const Config& c) {
     if (!ct.normal_direction.empty()) line("normal_direction", reals_text(ct.normal_direction));
     line("detection", toml_string(ct.detection));
     line("critical_separation", real_text(ct.critical_separation));
+    line("touching_tolerance", real_text(ct.touching_tolerance));
     line("corrections", toml_string(ct.corrections));
     line("three_or_more", toml_string(ct.three_or_more));
     line("xpic_correction", boolean(ct.xpic_correction));

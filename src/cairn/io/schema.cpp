@@ -368,6 +368,12 @@ std::vector<KeyDecl> make_declarations() {
                  "cp: critical separation delta_c in cells (seed 004 Eq. 16).")
                 .by_default("0.8")
                 .min(0.0));
+  k.push_back(Key("contact", "touching_tolerance", T::real,
+                 "lr and df: the fields touch when their edge separation is below this many cells "
+                 "(0 = seed 004 Eq. 24 exactly; particles in steady contact have a separation of "
+                 "zero to round-off, which then flips contact on and off).")
+                .by_default("1e-3")
+                .min(0.0));
   k.push_back(Key("contact", "corrections", T::string,
                  "twice: correct the extrapolated momenta and the updated momenta (seed 004 Eq. "
                  "26-34); once: only the updated momenta (for comparison).")
