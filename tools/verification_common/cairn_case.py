@@ -1,6 +1,6 @@
 """Shared plumbing for the verification cases under verification/<case>/run.
 
-Each case script imports this module (it adds verification/common to sys.path), then:
+Each case script imports this module (it adds tools/verification_common to sys.path), then:
   args = cairn_case.parse_args("bar_1d_mms", __doc__)   # --quick, --cairn, --out, --threads
   cairn_case.run_cairn(args, toml_path, out_dir)         # writes the input, runs `cairn run ... -q`
   cairn_case.stage_times(log)                            # seconds per stage of a run without -q
