@@ -29,6 +29,18 @@ Vec<D> offset_from_node(const Grid<D>& grid, std::int32_t node, const Vec<D>& x)
   return d;
 }
 
+/// Adds the seconds of its lifetime to `total` (the contact cost counters).
+struct ScopedSeconds {
+  explicit ScopedSeconds(double& total) : total_(total) {}
+  ~ScopedSeconds() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  ScopedSeconds(const ScopedSeconds&) = delete;
+  ScopedSeconds& operator=(const ScopedSeconds&) = delete;
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
 /// The DF table: a semi-infinite row of undeformed particles of length lp (l = h / ppc) ending
 /// at e (in cells) on the -x side of the node at 0, extrapolated with the run's shape family in
 /// 1D; s(e) = (sum S m x / sum S m) / h. Returned as increasing (s, e) pairs. This is the
@@ -159,15 +171,20 @@ void Contact<D>::fill_slots(const Particles<D>& particles, TransferCache<D>& cac
 }
 
 template <int D>
+double Contact<D>::cell_width(const Vec3& n) const {
+  double hn2 = 0.0;
+  for (int a = 0; a < D; ++a) hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
+  return std::sqrt(hn2);
+}
+
+template <int D>
 double Contact<D>::contact_area(const Vec3& n) const {
-  // A_c = V_cell / h_n with h_n = |(n_a h_a)|: the cell's cross-section normal to n for square
-  // cells (thickness in 2D, cross-section in 1D included through the cell volume).
-  double volume = 1.0, hn2 = 0.0;
-  for (int a = 0; a < D; ++a) {
-    volume *= grid_->cell_size()[a];
-    hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
-  }
-  return hn2 > 0.0 ? volume / std::sqrt(hn2) : 0.0;
+  // A_c = V_cell / h_n: the cell's cross-section normal to n for square cells (thickness in 2D,
+  // cross-section in 1D included through the cell volume).
+  double volume = 1.0;
+  for (int a = 0; a < D; ++a) volume *= grid_->cell_size()[a];
+  const double hn = cell_width(n);
+  return hn > 0.0 ? volume / hn : 0.0;
 }
 
 template <int D>
@@ -182,12 +199,7 @@ double Contact<D>::edge_distance(double s) const {
 
 template <int D>
 void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& cache, const std::vector<double>& mass) {
-  const auto t0 = std::chrono::steady_clock::now();
-  struct Lap {
-    std::chrono::steady_clock::time_point start;
-    double& total;
-    ~Lap() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
-  } lap{t0, prepare_seconds_};
+  const ScopedSeconds lap(prepare_seconds_);
   const int nf = n_fields();
   // Contact nodes: two or more fields with mass.
   for (std::int32_t c : nodes_) contact_of_[static_cast<std::size_t>(c)] = -1;
@@ -274,8 +286,7 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     }
   }
   // Normals and separations, node by node.
-  const auto t_fit = std::chrono::steady_clock::now();
-  Lap fit_lap{t_fit, fit_seconds_};
+  const ScopedSeconds fit_lap(fit_seconds_);
   const auto n_contact = static_cast<std::int64_t>(nc);
 #pragma omp parallel
   {
@@ -369,9 +380,7 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
       if (cloud_c[k] < 0) max_a = std::max(max_a, xn + R);
       else min_b = std::min(min_b, xn - R);
     }
-    double hn2 = 0.0;
-    for (int a = 0; a < D; ++a) hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
-    it.separation = min_b - max_a - cfg_.touching_tolerance * std::sqrt(hn2);
+    it.separation = min_b - max_a - cfg_.touching_tolerance * cell_width(n);
   } else {
     // Extrapolated centres x^a, x^b relative to the node (Eq. 11), lumped for beta when needed.
     Vec<D> xa = Vec<D>::Zero(), xb = Vec<D>::Zero();
@@ -392,14 +401,10 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     const double sa = to3<D>(xa).dot(n), sb = to3<D>(xb).dot(n);
     if (det == "cp") {
       // Eq. 16: (x^b - x^a).n < delta_c, delta_c in cells across the node along n.
-      double hn2 = 0.0;
-      for (int a = 0; a < D; ++a) hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
-      it.separation = (sb - sa) - cfg_.critical_separation * std::sqrt(hn2);
+      it.separation = (sb - sa) - cfg_.critical_separation * cell_width(n);
     } else {
       // Eq. 15: d(x^b) - d(x^a) with d from the family's table; beta mirrors alpha.
-      double hn2 = 0.0;
-      for (int a = 0; a < D; ++a) hn2 += n[a] * n[a] * grid_->cell_size()[a] * grid_->cell_size()[a];
-      const double h = std::sqrt(hn2);
+      const double h = cell_width(n);
       const double da = edge_distance(sa / h) * h;
       const double db = -edge_distance(-sb / h) * h;
       it.separation = db - da - cfg_.touching_tolerance * h;
@@ -413,12 +418,7 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
                          double time, double dt, std::vector<Vec<D>>* dv) {
   const std::size_t nc = nodes_.size();
   const bool record = pass == Pass::updated;
-  const auto t0 = std::chrono::steady_clock::now();
-  struct Lap {
-    std::chrono::steady_clock::time_point start;
-    double& total;
-    ~Lap() { total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
-  } lap{t0, correct_seconds_};
+  const ScopedSeconds lap(correct_seconds_);
   if (record) {
     active_ = 0;
     for (auto& f : pair_force_) f.setZero();

@@ -84,6 +84,8 @@ class Contact {
   void geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
                 const std::vector<double>& mass, std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c,
                 std::vector<std::int32_t>& cloud_p, Interaction& it) const;
+  /// h_n = |(n_a h_a)|: the cell's width along unit n (the cell size for square cells).
+  [[nodiscard]] double cell_width(const Vec3& n) const;
   [[nodiscard]] double contact_area(const Vec3& n) const;
   [[nodiscard]] int law_of(int a, int b) const { return pair_law_[static_cast<std::size_t>(a * n_fields() + b)]; }
   [[nodiscard]] double edge_distance(double s) const;  ///< DF: d(s) of a field on the -n side
