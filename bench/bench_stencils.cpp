@@ -4,6 +4,8 @@
 // that cpGIMP, CPDI and B2CPDI do their full work. The target: CPDI and B2CPDI within
 // twice the quadratic B-spline (bspline2) of the same run; docs/shape-functions.md records the
 // measured ratios. Run: build/release/bench/cairn_bench --benchmark_filter=Stencil
+// --benchmark_repetitions=7 --benchmark_enable_random_interleaving=true (take the minimum: single
+// runs on a shared machine scatter by about 15 %).
 #include <benchmark/benchmark.h>
 #include <omp.h>
 

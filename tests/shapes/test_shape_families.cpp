@@ -333,9 +333,13 @@ TEST(ShapeFamilies, CpdiWeightsAreTheExactIntegralsOfTheCornerInterpolation) {
   shear(1, 0) = -0.2;
   shear(2, 2) = 0.7;
   shear(2, 0) = 0.3;
+  // The identity keeps the domain inside the fixed (n_nodes + 1)^D node box of the fast path;
+  // the stretched shear spans more than one cell along x, so it takes the general box.
+  Mat3 stretched = shear;
+  stretched(0, 0) = 2.0;  // span 1.82 cells, inside the default guard cpdi_max_span = 2
   for (const char* name : {"cpdi", "b2cpdi"}) {
     double (*N)(double) = std::string(name) == "cpdi" ? hat : quadratic_spline;
-    for (const Mat3& F : {Mat3(Mat3::Identity()), shear}) {
+    for (const Mat3& F : {Mat3(Mat3::Identity()), shear, stretched}) {
       EXPECT_TRUE(cpdi_integrals_match<1>(name, N, F, Vec<1>(0.4321), 0.07));
       EXPECT_TRUE(cpdi_integrals_match<2>(name, N, F, Vec<2>(0.4321, 0.5917), 0.07));
       EXPECT_TRUE(cpdi_integrals_match<3>(name, N, F, Vec<3>(0.4321, 0.5917, 0.3333), 0.07));

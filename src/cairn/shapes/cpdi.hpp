@@ -91,6 +91,97 @@ Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_
   return dom;
 }
 
+constexpr int ipow(int base, int exponent) { return exponent == 0 ? 1 : base * ipow(base, exponent - 1); }
+
+/// Fixed node box of the common case: every corner's first node along each axis is lo or lo + 1,
+/// so the box is (n_nodes + 1)^D with compile-time strides. Each entry accumulates
+/// (S, G) as one (D+1)-vector, so a corner's contribution N (1/2^D, g_c) is one vector update.
+template <int D, class Fn>
+struct FixedBox {
+  using Entry = Eigen::Matrix<double, D + 1, 1>;
+  static constexpr int width = Fn::n_nodes + 1;
+  static constexpr int size = ipow(width, D);
+  std::array<Entry, size> acc;
+};
+
+/// Accumulate S_i = 2^-D sum_c N_i(x_c) and G_i = sum_c N_i(x_c) g_c into a FixedBox; g holds
+/// the corner gradients g_c = 2^-D R^-T s_c (physical units).
+template <int D, class Fn>
+void accumulate_fixed(const Domain<D>& dom, const std::array<Vec<D>, (1 << D)>& g,
+                      FixedBox<D, Fn>& box) {
+  using Entry = typename FixedBox<D, Fn>::Entry;
+  constexpr int nn = Fn::n_nodes;
+  constexpr int W = FixedBox<D, Fn>::width;
+  constexpr int n_corners = Domain<D>::n_corners;
+  // All corner updates (2^-D, g_c) are assembled before the loop, so that the vector loads in
+  // it never wait on the scalar stores that build them.
+  std::array<Entry, n_corners> update;
+  for (int c = 0; c < n_corners; ++c) {
+    update[c][0] = 1.0 / n_corners;
+    update[c].template tail<D>() = g[c];
+  }
+  for (Entry& e : box.acc) e.setZero();
+  for (int c = 0; c < n_corners; ++c) {
+    double v[D][nn];
+    int base = 0, scale = 1;
+    for (int a = 0; a < D; ++a) {
+      base += (Fn::weights(dom.corner[c][a], v[a]) - dom.lo[a]) * scale;
+      scale *= W;
+    }
+    const Entry gc = update[c];
+    if constexpr (D == 1) {
+      for (int i = 0; i < nn; ++i) box.acc[base + i] += v[0][i] * gc;
+    } else if constexpr (D == 2) {
+      for (int j = 0; j < nn; ++j)
+        for (int i = 0; i < nn; ++i) box.acc[base + j * W + i] += (v[0][i] * v[1][j]) * gc;
+    } else {
+      for (int k = 0; k < nn; ++k)
+        for (int j = 0; j < nn; ++j) {
+          const double vjk = v[1][j] * v[2][k];
+          Entry* row = &box.acc[base + (k * W + j) * W];
+          for (int i = 0; i < nn; ++i) row[i] += (v[0][i] * vjk) * gc;
+        }
+    }
+  }
+}
+
+/// Write the non-zero entries of a FixedBox into one particle's cache slots. `offset[a][k]` is the
+/// storage offset of node lo[a] + k along axis a (-1 beyond the ghost layers). S = 0 means every
+/// corner weight was zero (the grid functions are non-negative), so G = 0 too. Returns the
+/// number of entries kept; `outside` is set when a non-zero entry has no storage. Writes up to
+/// FixedBox::size slots (the cache stride is at least that).
+template <int D, class Fn>
+int compact_fixed(const FixedBox<D, Fn>& box,
+                  const std::array<std::array<std::int32_t, FixedBox<D, Fn>::width>, D>& offset,
+                  std::int32_t* node, double* S, Vec<D>* G, bool& outside) {
+  constexpr int W = FixedBox<D, Fn>::width;
+  constexpr int rows = FixedBox<D, Fn>::size / W;
+  int used = 0;
+  for (int row = 0; row < rows; ++row) {
+    std::int32_t row_node = 0;
+    bool row_outside = false;
+    int rem = row;
+    for (int a = 1; a < D; ++a) {
+      const std::int32_t off = offset[a][rem % W];
+      rem /= W;
+      row_outside |= off < 0;
+      row_node += off;
+    }
+    // Branch-free: every entry is written at `used`, which only advances past non-zero ones
+    // (which entries vanish varies from particle to particle, so a branch mispredicts often).
+    for (int i = 0; i < W; ++i) {
+      const auto& e = box.acc[row * W + i];
+      const bool keep = e[0] != 0.0;
+      outside |= keep & (row_outside | (offset[0][i] < 0));
+      node[used] = row_node + offset[0][i];
+      S[used] = e[0];
+      G[used] = e.template tail<D>();
+      used += keep;
+    }
+  }
+  return used;
+}
+
 }  // namespace cpdi_detail
 
 /// Fill the cache with CPDI weights of grid function Fn (see the file comment).
@@ -100,6 +191,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   using Domain = cpdi_detail::Domain<D>;
   using MatD = Eigen::Matrix<double, D, D>;
   constexpr int n_corners = Domain::n_corners;
+  using Fixed = cpdi_detail::FixedBox<D, Fn>;
   constexpr int nn = Fn::n_nodes;
   const auto n = static_cast<std::int64_t>(particles.n());
   const Vec<D> h = grid.cell_size();
@@ -108,6 +200,14 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   // The cache stride must hold the largest node box of the step. Reuse the stride of the last
   // step when the cache already has one for these particles; a particle whose box does not fit
   // sends the build through the sizing pass and a second try (rare: the stride only grows).
+  // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c, where
+  // R = diag(h) Rc is the physical half-edge matrix (corner domains only, not the fallback).
+  const auto corner_gradients = [&h](const Domain& dom) {
+    const MatD RinvT = (h.asDiagonal() * dom.Rc).inverse().transpose() / static_cast<double>(n_corners);
+    std::array<Vec<D>, n_corners> g;
+    for (int c = 0; c < n_corners; ++c) g[c] = RinvT * cpdi_detail::corner_sign<D>(c);
+    return g;
+  };
   int slots = 1, widest = 1;
   bool sized = !(cache.stride > 0 && cache.count.size() == particles.n());
   if (!sized) {
@@ -118,9 +218,9 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
   for (int attempt = 0; attempt < 2; ++attempt) {
   if (sized) {
-    // Sizing pass: the largest node box of this step.
-    slots = 1;
-    widest = 1;
+    // Sizing pass: the largest node box of this step, at least the fixed box.
+    slots = Fixed::size;
+    widest = Fixed::width;
 #pragma omp parallel for reduction(max : slots, widest) schedule(static)
     for (std::int64_t p = 0; p < n; ++p) {
       const IVec<D> dims = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span).dims;
@@ -140,6 +240,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     bool overflow_t = false;
     std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * widest);
     std::array<std::vector<double>, D> w1, dw1;  // fallback weights per axis
+    cpdi_detail::FixedBox<D, Fn> fixed_box;
     for (int a = 0; a < D; ++a) {
       w1[a].resize(widest);
       dw1[a].resize(widest);
@@ -150,118 +251,119 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       IVec<D> cell;
       for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(dom.xi[a]));
       cache.cell[p] = cell;
+      // The common case takes the fixed (n_nodes + 1)^D box; stretched domains, the fallback and
+      // a stride sized for smaller boxes take the general box of dom.dims.
+      const bool fixed = !dom.fallback && dom.dims.maxCoeff() <= Fixed::width &&
+                         Fixed::size <= cache.stride;
+      const IVec<D> dims = fixed ? IVec<D>::Constant(Fixed::width) : dom.dims;
       IVec<D> stride;
       int box = 1;
       for (int a = 0; a < D; ++a) {
         stride[a] = box;
-        box *= dom.dims[a];
+        box *= dims[a];
       }
-      if (box > cache.stride || dom.dims.maxCoeff() > widest) {
+      if (box > cache.stride || dims.maxCoeff() > widest) {
         overflow_t = true;  // the reused stride is too small: size and build again
         continue;
       }
-      // Accumulate straight into the particle's cache slots (box order, box <= stride), then
-      // compact them in place.
       const std::size_t out = static_cast<std::size_t>(p) * cache.stride;
       double* S = &cache.weight[out];
       Vec<D>* G = &cache.gradient[out];
-      std::fill(S, S + box, 0.0);
-      std::fill(G, G + box, Vec<D>::Zero());
-
-      if (dom.fallback) {
-        // GIMP of the undeformed box: tensor product of the exact 1D convolutions.
-        for (int a = 0; a < D; ++a)
-          convolved_weights<Fn>(dom.xi[a], dom.half[a], dom.dims[a], w1[a].data(), dw1[a].data());
-        for (int idx = 0; idx < box; ++idx) {
-          double value = 1.0;
-          Vec<D> grad = Vec<D>::Ones();
-          int rem = idx;
-          for (int a = 0; a < D; ++a) {
-            const int k = rem % dom.dims[a];
-            rem /= dom.dims[a];
-            value *= w1[a][k];
-            for (int b = 0; b < D; ++b) grad[b] *= (a == b) ? dw1[a][k] * inv_h[a] : w1[a][k];
-          }
-          S[idx] = value;
-          G[idx] = grad;
-        }
+      if (fixed) {
+        cpdi_detail::accumulate_fixed<D, Fn>(dom, corner_gradients(dom), fixed_box);
       } else {
-        // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c, where
-        // R = diag(h) Rc is the physical half-edge matrix.
-        const MatD RinvT =
-            (h.asDiagonal() * dom.Rc).inverse().transpose() / static_cast<double>(n_corners);
-        for (int c = 0; c < n_corners; ++c) {
-          const Vec<D> g = RinvT * cpdi_detail::corner_sign<D>(c);
-          std::array<std::array<double, nn>, D> v;
-          int base = 0;
+        // General box: accumulate straight into the particle's cache slots (box order,
+        // box <= stride), compacted in place below.
+        std::fill(S, S + box, 0.0);
+        std::fill(G, G + box, Vec<D>::Zero());
+        if (dom.fallback) {
+          // GIMP of the undeformed box: tensor product of the exact 1D convolutions.
           for (int a = 0; a < D; ++a)
-            base += (Fn::weights(dom.corner[c][a], v[a].data()) - dom.lo[a]) * stride[a];
-          if constexpr (D == 1) {
-            for (int i = 0; i < nn; ++i) {
-              S[base + i] += v[0][i];
-              G[base + i] += v[0][i] * g;
+            convolved_weights<Fn>(dom.xi[a], dom.half[a], dims[a], w1[a].data(), dw1[a].data());
+          for (int idx = 0; idx < box; ++idx) {
+            double value = 1.0;
+            Vec<D> grad = Vec<D>::Ones();
+            int rem = idx;
+            for (int a = 0; a < D; ++a) {
+              const int k = rem % dims[a];
+              rem /= dims[a];
+              value *= w1[a][k];
+              for (int b = 0; b < D; ++b) grad[b] *= (a == b) ? dw1[a][k] * inv_h[a] : w1[a][k];
             }
-          } else if constexpr (D == 2) {
-            for (int j = 0; j < nn; ++j) {
-              const int row = base + j * stride[1];
-              for (int i = 0; i < nn; ++i) {
-                const double N = v[0][i] * v[1][j];
-                S[row + i] += N;
-                G[row + i] += N * g;
-              }
-            }
-          } else {
-            for (int k = 0; k < nn; ++k)
-              for (int j = 0; j < nn; ++j) {
-                const double vjk = v[1][j] * v[2][k];
-                const int row = base + j * stride[1] + k * stride[2];
-                for (int i = 0; i < nn; ++i) {
-                  const double N = v[0][i] * vjk;
-                  S[row + i] += N;
-                  G[row + i] += N * g;
-                }
-              }
+            S[idx] = value;
+            G[idx] = grad;
           }
+        } else {
+          const std::array<Vec<D>, n_corners> g = corner_gradients(dom);
+          for (int c = 0; c < n_corners; ++c) {
+            std::array<std::array<double, nn>, D> v;
+            int base = 0;
+            for (int a = 0; a < D; ++a)
+              base += (Fn::weights(dom.corner[c][a], v[a].data()) - dom.lo[a]) * stride[a];
+            for (int idx = 0; idx < cpdi_detail::ipow(nn, D); ++idx) {
+              int rem = idx, at = base;
+              double N = 1.0;
+              for (int a = 0; a < D; ++a) {
+                const int k = rem % nn;
+                rem /= nn;
+                N *= v[a][k];
+                at += k * stride[a];
+              }
+              S[at] += N;
+              G[at] += N * g[c];
+            }
+          }
+          const double inv_corners = 1.0 / n_corners;
+          for (int idx = 0; idx < box; ++idx) S[idx] *= inv_corners;
         }
-        const double inv_corners = 1.0 / n_corners;
-        for (int idx = 0; idx < box; ++idx) S[idx] *= inv_corners;
       }
 
       // Compact the non-zero entries into the cache: rows along axis 0, the other axes by an
-      // odometer. The box bounds give the colouring reach.
+      // odometer (used <= idx, so the general box compacts in place). The box bounds give the
+      // colouring reach.
       for (int a = 0; a < D; ++a) {
-        for (int k = 0; k < dom.dims[a]; ++k) offset[a * widest + k] = grid.axis_index(a, dom.lo[a] + k);
         lo_t[a] = std::max(lo_t[a], cell[a] - dom.lo[a]);
         hi_t[a] = std::max(hi_t[a], dom.lo[a] + dom.dims[a] - 1 - cell[a] - 1);
       }
       int used = 0;
-      const int n_rows = box / dom.dims[0];
-      IVec<D> k = IVec<D>::Zero();
-      for (int row = 0; row < n_rows; ++row) {
-        std::int32_t row_node = 0;
-        bool row_outside = false;
-        for (int a = 1; a < D; ++a) {
-          const std::int32_t off = offset[a * widest + k[a]];
-          row_outside |= off < 0;
-          row_node += off;
-        }
-        const int first = row * dom.dims[0];
-        for (int i = 0; i < dom.dims[0]; ++i) {
-          const int idx = first + i;
-          if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
-          const std::int32_t off = offset[i];
-          if (row_outside || off < 0) {
-            bad_t = std::min<std::int64_t>(bad_t, p);
-            continue;
+      if (fixed) {
+        std::array<std::array<std::int32_t, Fixed::width>, D> off;
+        for (int a = 0; a < D; ++a)
+          for (int k = 0; k < Fixed::width; ++k) off[a][k] = grid.axis_index(a, dom.lo[a] + k);
+        bool outside = false;
+        used = cpdi_detail::compact_fixed<D, Fn>(fixed_box, off, &cache.node[out], S, G, outside);
+        if (outside) bad_t = std::min<std::int64_t>(bad_t, p);
+      } else {
+        for (int a = 0; a < D; ++a)
+          for (int k = 0; k < dims[a]; ++k) offset[a * widest + k] = grid.axis_index(a, dom.lo[a] + k);
+        const int n_rows = box / dims[0];
+        IVec<D> k = IVec<D>::Zero();
+        for (int row = 0; row < n_rows; ++row) {
+          std::int32_t row_node = 0;
+          bool row_outside = false;
+          for (int a = 1; a < D; ++a) {
+            const std::int32_t off = offset[a * widest + k[a]];
+            row_outside |= off < 0;
+            row_node += off;
           }
-          cache.node[out + used] = row_node + off;
-          S[used] = S[idx];  // used <= idx: in-place compaction
-          G[used] = G[idx];
-          ++used;
-        }
-        for (int a = 1; a < D; ++a) {
-          if (++k[a] < dom.dims[a]) break;
-          k[a] = 0;
+          const int first = row * dims[0];
+          for (int i = 0; i < dims[0]; ++i) {
+            const int idx = first + i;
+            if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
+            const std::int32_t off = offset[i];
+            if (row_outside || off < 0) {
+              bad_t = std::min<std::int64_t>(bad_t, p);
+              continue;
+            }
+            cache.node[out + used] = row_node + off;
+            S[used] = S[idx];
+            G[used] = G[idx];
+            ++used;
+          }
+          for (int a = 1; a < D; ++a) {
+            if (++k[a] < dims[a]) break;
+            k[a] = 0;
+          }
         }
       }
       cache.count[p] = static_cast<std::uint16_t>(used);
