@@ -8,8 +8,8 @@
 // Each step, prepare() lists every prescribed (node, direction) with its start and end values;
 // apply() imposes one of the two on a velocity field. Every place of the step that imposes the
 // [boundary] faces imposes these too, right after them: the lumped correction of v and v+
-// (Task 3), and the velocity, lumped and combined methods of the full-mass expansion (seed 000
-// Eq. 3, Simulation::full_mass_velocity).
+// (Task 3), and the velocity, lumped, combined (seed 000 Eq. 3) and constrained methods of the
+// full-mass expansion (Simulation::full_mass_velocity).
 //
 // Precedence: entries are imposed in order - [boundary] faces first, then [[velocity]] tables in
 // input order, then [[wall]] tables in input order - so where two of them hold the same node

@@ -54,7 +54,7 @@ struct MethodConfig {
   double grid_damping = 0.0;      ///< alpha_g (seed 002 Eq. 1.83)
   double particle_damping = 0.0;  ///< alpha_p (seed 002 Eq. 1.83)
   double full_mass_cfl = 0.0;     ///< periodic FMPM/XPIC CFL_X; 0 = every step
-  std::string velocity_bc_method = "combined";  ///< FMPM velocity conditions: velocity|lumped|combined
+  std::string velocity_bc_method = "constrained";  ///< FMPM/XPIC velocity conditions: velocity|lumped|combined|constrained
   std::string time_integration = "forward_euler";  ///< or central_difference
 };
 

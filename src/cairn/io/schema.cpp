@@ -161,10 +161,12 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("0.0")
                 .min(0.0));
   k.push_back(Key("method", "velocity_bc_method", T::string,
-                 "How FMPM/XPIC impose grid velocity conditions (seed 000 Sec. 2.4): velocity, "
-                 "lumped or combined.")
-                .by_default("\"combined\"")
-                .choices([] { return std::vector<std::string>{"velocity", "lumped", "combined"}; }));
+                 "How FMPM/XPIC impose grid velocity conditions: velocity, lumped or combined "
+                 "(seed 000 Sec. 2.4), or constrained (conditions imposed after every term of the "
+                 "expansion; same as combined for k <= 2, stays stable at held faces for any k "
+                 "where combined grows; docs/boundary-conditions.md).")
+                .by_default("\"constrained\"")
+                .choices([] { return std::vector<std::string>{"velocity", "lumped", "combined", "constrained"}; }));
   k.push_back(Key("method", "time_integration", T::string,
                  "forward_euler (seed 003 Eq. 6-10) or central_difference: velocities at half "
                  "steps, started by half the first acceleration (seed 003 Eq. 11-15, seed 001 "
@@ -668,7 +670,7 @@ const std::vector<SectionDoc>& section_docs() {
       {"velocity", "[[velocity]]",
        "A prescribed grid velocity component on a node set: the intersection of the selectors "
        "given (face, box, plane). Imposed with the [boundary] faces in every scheme, including the "
-       "velocity, lumped and combined full-mass methods (seed 000 Eq. 3); its reaction force is in "
+       "velocity, lumped, combined and constrained full-mass methods (seed 000 Eq. 3); its reaction force is in "
        "history.csv. See docs/boundary-conditions.md.",
        "[[velocity]]\n"
        "name = \"grip\"\n"

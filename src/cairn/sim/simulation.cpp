@@ -403,9 +403,10 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
   // Summing powers of the small operator A is the same polynomial as the alternating binomial
   // sum, without its cancellation for large k. (The recursion printed after Eq. 1 must start
   // from v*_1 = k m^-1 p for its terms to be binom(k, l) (S+S)^(l-1) m^-1 p.)
-  // Velocity conditions (seed 000 Sec. 2.4, Eq. 3): `lumped` and `combined` start from the
-  // corrected lumped velocity `in`; `velocity` from the uncorrected one; `velocity` and
-  // `combined` impose the conditions again on the result.
+  // Velocity conditions (seed 000 Sec. 2.4, Eq. 3): `lumped`, `combined` and `constrained`
+  // start from the corrected lumped velocity `in`; `velocity` from the uncorrected one;
+  // `velocity` and `combined` impose the conditions again on the result, `constrained` after
+  // every term.
   const std::string& method = config_.method.velocity_bc_method;
   // The uncorrected start is rebuilt from the step's p (and f) when `in` is one of the step's
   // own grid velocities; stress-update velocities (USF, USL+) start from their corrected value.
@@ -418,6 +419,25 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
     else if (m <= small_mass_) grid_term_[i].setZero();
     else grid_term_[i] = (nodes_.momentum[i] + (from_p_new ? Vec<D>(nodes_.force[i] * step_dt_) : Vec<D>::Zero())) / m;
   });
+  using When = typename VelocityConditions<D>::When;
+  const When when = from_p ? When::start : from_p_new ? When::end : work_when_;
+  if (method == "constrained") {
+    // Truncated Neumann series of the constrained system: the held components take their
+    // prescribed values and the free ones solve (S+S)_ff v_f = v_f^(L) - (S+S)_fc v_c. As the
+    // Richardson iteration v <- v + (v^(L) - S+S v), conditions imposed after every term; with
+    // no conditions it is the same polynomial (I + A + ... + A^(k-1)) v^(L). Every term then
+    // satisfies the homogeneous conditions, so the particle round trip has eigenvalues
+    // 1 - (1 - mu)^k in [0, 1] (mu: eigenvalues of the principal block (S+S)_ff), where
+    // `combined` (conditions on the start and the end only) approaches (K^-1)_ff K_ff, whose
+    // eigenvalues are >= 1 (docs/boundary-conditions.md).
+    for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
+    for (int j = 1; j < k; ++j) {
+      lumped_projection(out, grid_proj_);
+      for_each_node(n_slots(), [&](std::int32_t i) { out[i] += grid_term_[i] - grid_proj_[i]; });
+      impose_conditions(out, when);
+    }
+    return;
+  }
   for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
   for (int j = 1; j < k; ++j) {
     lumped_projection(grid_term_, grid_proj_);
@@ -426,8 +446,7 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
       out[i] += grid_term_[i];
     });
   }
-  using When = typename VelocityConditions<D>::When;
-  if (method != "lumped") impose_conditions(out, from_p ? When::start : from_p_new ? When::end : work_when_);
+  if (method != "lumped") impose_conditions(out, when);
 }
 
 template <int D>
