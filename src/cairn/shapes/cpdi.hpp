@@ -197,9 +197,6 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   const Vec<D> h = grid.cell_size();
   const Vec<D> inv_h = h.cwiseInverse();
 
-  // The cache stride must hold the largest node box of the step. Reuse the stride of the last
-  // step when the cache already has one for these particles; a particle whose box does not fit
-  // sends the build through the sizing pass and a second try (rare: the stride only grows).
   // S_i = 2^-D sum_c N_i(x_c), G_i = sum_c N_i(x_c) g_c with g_c = 2^-D R^-T s_c, where
   // R = diag(h) Rc is the physical half-edge matrix (corner domains only, not the fallback).
   const auto corner_gradients = [&h](const Domain& dom) {
@@ -208,6 +205,10 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     for (int c = 0; c < n_corners; ++c) g[c] = RinvT * cpdi_detail::corner_sign<D>(c);
     return g;
   };
+  // The cache stride must hold the largest node box of the step (and at least the fixed box).
+  // Reuse the stride of the last step when the cache already has one for these particles; a
+  // particle whose box does not fit sends the build through the sizing pass and a second try
+  // (rare: the stride only grows).
   int slots = 1, widest = 1;
   bool sized = !(cache.stride > 0 && cache.count.size() == particles.n());
   if (!sized) {
