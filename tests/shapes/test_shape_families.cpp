@@ -147,7 +147,9 @@ void expect_same_weights(const TransferCache<D>& a, const TransferCache<D>& b, s
     EXPECT_LT((wa[node].second - sg.second).norm(), tol * 10.0) << what << " node " << node;
   }
   for (const auto& [node, sg] : wa)
-    if (!wb.count(node)) EXPECT_LT(std::abs(sg.first) + sg.second.norm(), tol) << what;
+    if (!wb.count(node)) {
+      EXPECT_LT(std::abs(sg.first) + sg.second.norm(), tol) << what;
+    }
 }
 
 TEST(ShapeFamilies, UGimpWithSmoothingLengthHEqualsTheQuadraticSpline) {
@@ -444,9 +446,13 @@ TEST(ShapeFamilies, OpenKnotSplinesAreOneOnTheFacesAndHaveNPlusPFunctions) {
     EXPECT_NEAR(w0[lower].first, 1.0, 1e-13) << name;
     EXPECT_NEAR(w1[upper].first, 1.0, 1e-13) << name;  // x = 0.6 is 6 cells up to rounding
     for (const auto& [node, sg] : w0)
-      if (node != lower) EXPECT_NEAR(sg.first, 0.0, 1e-13) << name;
+      if (node != lower) {
+        EXPECT_NEAR(sg.first, 0.0, 1e-13) << name;
+      }
     for (const auto& [node, sg] : w1)
-      if (node != upper) EXPECT_NEAR(sg.first, 0.0, 1e-13) << name;
+      if (node != upper) {
+        EXPECT_NEAR(sg.first, 0.0, 1e-13) << name;
+      }
     // Mirror symmetry of the basis about the middle of the domain.
     for (int k = 0; k < samples; ++k) {
       double s_lower_k = weights_of(c, k)[lower].first;

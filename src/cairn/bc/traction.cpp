@@ -9,18 +9,6 @@
 
 namespace cairn {
 
-ParticleDomain particle_domain_of(const std::string& shape_family) {
-  // The families whose particle domain deforms with F. A new family that tracks its domain adds
-  // itself here (docs/boundary-conditions.md).
-  static const std::map<std::string, ParticleDomain> tracked{
-      {"cpdi", ParticleDomain::convected},
-      {"b2cpdi", ParticleDomain::convected},
-      {"cpgimp", ParticleDomain::stretched},
-  };
-  const auto it = tracked.find(shape_family);
-  return it == tracked.end() ? ParticleDomain::undeformed : it->second;
-}
-
 namespace {
 
 /// Lattice site of a particle: bodies are filled on a lattice of spacing l_p0 from the grid origin.
@@ -39,9 +27,10 @@ std::int64_t lattice_key(const Vec<D>& X, const Vec<D>& origin, const Vec<D>& sp
 }  // namespace
 
 template <int D>
-Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles) {
+Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles,
+                        ParticleDomain domain) {
   if (config.tractions.empty()) return;
-  domain_ = particle_domain_of(config.method.shape);
+  domain_ = domain;
   thickness_ = D == 3 ? 1.0 : config.simulation.thickness;
 
   // Occupied lattice sites per body.

@@ -50,20 +50,15 @@
 
 namespace cairn {
 
-/// How the particle domain used for face areas follows the deformation.
-enum class ParticleDomain { undeformed, stretched, convected };
-
-/// The domain a registered shape family tracks: convected for cpdi/b2cpdi, stretched for cpgimp,
-/// undeformed otherwise.
-ParticleDomain particle_domain_of(const std::string& shape_family);
-
 template <int D>
 class Tractions {
  public:
   Tractions() = default;
-  /// Select the loaded faces of every [[traction]]. Throws std::invalid_argument naming the
-  /// traction and its line when one selects no face or its scale does not parse.
-  Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles);
+  /// Select the loaded faces of every [[traction]]. `domain`: the particle domain of the run's
+  /// shape family (ShapeFamily::particle_domain), which sets how face areas deform. Throws
+  /// std::invalid_argument naming the traction and its line when one selects no face or its
+  /// scale does not parse.
+  Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles, ParticleDomain domain);
 
   [[nodiscard]] bool empty() const { return loads_.empty(); }
   /// Number of faces loaded by traction `k`.

@@ -10,6 +10,7 @@ class Cpdi final : public ShapeFamily<D> {
  public:
   explicit Cpdi(const ShapeContext& ctx) : max_span_(ctx.method.cpdi_max_span) {}
   int ghost_layers() const override { return 2; }
+  ParticleDomain particle_domain() const override { return ParticleDomain::convected; }
   void build(const Grid<D>& g, const Particles<D>& p, TransferCache<D>& c) const override {
     build_cpdi<D, LinearGridFunction>(max_span_, g, p, c);
   }

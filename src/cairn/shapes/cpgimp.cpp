@@ -12,6 +12,7 @@ class CpGimp final : public ShapeFamily<D> {
  public:
   explicit CpGimp(const ShapeContext&) {}
   int ghost_layers() const override { return 2; }
+  ParticleDomain particle_domain() const override { return ParticleDomain::stretched; }
   void build(const Grid<D>& g, const Particles<D>& p, TransferCache<D>& c) const override {
     const Vec<D> h = g.cell_size();
     build_convolved<D, LinearGridFunction>(

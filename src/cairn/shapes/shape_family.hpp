@@ -33,6 +33,14 @@ enum class FaceBasis {
   open_knot,
 };
 
+/// How the particle domain a family integrates over follows the deformation; tractions on
+/// particle faces use it for the face areas (bc/traction).
+enum class ParticleDomain {
+  undeformed,  ///< the initial box l_p0 (GIMP, uGIMP, splines, linear)
+  stretched,   ///< the box l_p0 diag(F) (cpGIMP, seed 003 Sec. 3.3)
+  convected,   ///< the parallelogram/parallelepiped F diag(l_p0) (CPDI, B2CPDI)
+};
+
 template <int D>
 class ShapeFamily {
  public:
@@ -41,6 +49,8 @@ class ShapeFamily {
   [[nodiscard]] virtual int ghost_layers() const = 0;
   /// How the family's values relate to the faces (default: ghost nodes).
   [[nodiscard]] virtual FaceBasis face_basis() const { return FaceBasis::ghost_nodes; }
+  /// The particle domain the family tracks (default: the undeformed box).
+  [[nodiscard]] virtual ParticleDomain particle_domain() const { return ParticleDomain::undeformed; }
   /// Position of the degree of freedom stored at node `index`: the node itself for nodal
   /// families, the Greville abscissa (knot average) for open-knot splines. sum_i S_pi x_i = x_p
   /// holds with these positions; tests and plots use it.

@@ -87,7 +87,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
-  tractions_ = Tractions<D>(config_, grid_, particles_);
+  tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
