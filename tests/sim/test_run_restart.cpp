@@ -51,6 +51,22 @@ fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
+TEST(RunLoop, TimeStepNoteForFmpmAboveItsCriticalCfl) {
+  // FMPM(k) lowers the critical time step by up to sqrt(k) (docs/update-schemes.md): a note when
+  // cfl * sqrt(k) > 0.6 under the CFL rule, nothing otherwise.
+  auto note = [](const std::vector<std::string>& sets) {
+    return time_step_note(load_config_string(block_input, "block.toml", sets));
+  };
+  EXPECT_NE(note({"method.update=\"fmpm\"", "method.order=4", "simulation.cfl=0.5"}).find("FMPM(4)"),
+            std::string::npos);
+  EXPECT_NE(note({"method.update=\"fmpm\"", "method.order=2", "simulation.cfl=0.5"}), "");
+  EXPECT_EQ(note({"method.update=\"fmpm\"", "method.order=4", "simulation.cfl=0.2"}), "");
+  EXPECT_EQ(note({"method.update=\"fmpm\"", "method.order=8", "simulation.cfl=0.2"}), "");
+  EXPECT_EQ(note({"method.update=\"xpic\"", "method.order=8", "simulation.cfl=0.5"}), "");
+  EXPECT_EQ(note({"method.update=\"fmpm\"", "method.order=8", "simulation.dt=1e-7"}), "");
+  EXPECT_EQ(note({}), "");
+}
+
 TEST(RunLoop, RestartFromMidwayCheckpointIsBitIdentical) {
   const fs::path a = fresh_dir("full"), b = fresh_dir("restarted");
   RunOptions quiet{true};

@@ -76,7 +76,8 @@ std::vector<KeyDecl> make_declarations() {
                 .required()
                 .min(above_zero));
   k.push_back(Key("simulation", "cfl", T::real,
-                 "Courant number: dt = cfl * h_min / (c_max + max|v|).")
+                 "Courant number: dt = cfl * h_min / (c_max + max|v|). FMPM(k) needs less (about "
+                 "0.6 / sqrt(k); docs/update-schemes.md).")
                 .by_default("0.5")
                 .min(above_zero)
                 .max(2.0));

@@ -99,6 +99,8 @@ class Runner {
     const long long first_step = sim_.step_count();
     const auto& s = config_.simulation;
     if (!restarted_) {
+      if (const std::string note = time_step_note(config_); !note.empty())
+        std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
       write_history_row();
       write_snapshot();
@@ -296,6 +298,20 @@ RunSummary run_dim(const Config& config, const RunOptions& options, const Checkp
 }
 
 }  // namespace
+
+std::string time_step_note(const Config& config) {
+  const int k = config.method.order;
+  const double cfl = config.simulation.cfl;
+  if (config.method.update != "fmpm" || k < 2 || config.simulation.fixed_dt > 0.0) return {};
+  if (cfl * std::sqrt(static_cast<double>(k)) <= 0.6) return {};
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "note: FMPM(%d) lowers the critical time step (by up to sqrt(k) on GIMP and B-spline "
+                "grids), so cfl = %g may be unstable; cfl <= %.2g keeps cfl * sqrt(k) <= 0.6 (seed 000 uses "
+                "0.2; measured limits in docs/update-schemes.md)",
+                k, cfl, 0.6 / std::sqrt(static_cast<double>(k)));
+  return text;
+}
 
 RunSummary run(const Config& config, const RunOptions& options) {
   switch (config.simulation.dimension) {

@@ -41,6 +41,12 @@ class RunFailure : public std::runtime_error {
 /// Run a validated config from t = 0 (dispatches on simulation.dimension).
 RunSummary run(const Config& config, const RunOptions& options);
 
+/// A note for runs whose time step is likely too large for their update: FMPM(k) replaces the
+/// lumped mass by a k-term expansion of the full mass matrix, which lowers the critical time step
+/// by up to sqrt(k) on GIMP and B-spline grids (docs/update-schemes.md, measured limits). Empty
+/// when the CFL rule with simulation.cfl * sqrt(k) <= 0.6 is used, or for other updates.
+std::string time_step_note(const Config& config);
+
 /// Continue from a checkpoint written by run(); `overrides` (`--set`) apply to the stored input.
 /// A restart without overrides ends bit-identical to the run that never stopped.
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
