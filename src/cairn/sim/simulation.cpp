@@ -421,6 +421,7 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
   });
   using When = typename VelocityConditions<D>::When;
   const When when = from_p ? When::start : from_p_new ? When::end : work_when_;
+  for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
   if (method == "constrained") {
     // Truncated Neumann series of the constrained system: the held components take their
     // prescribed values and the free ones solve (S+S)_ff v_f = v_f^(L) - (S+S)_fc v_c. As the
@@ -430,7 +431,6 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
     // 1 - (1 - mu)^k in [0, 1] (mu: eigenvalues of the principal block (S+S)_ff), where
     // `combined` (conditions on the start and the end only) approaches (K^-1)_ff K_ff, whose
     // eigenvalues are >= 1 (docs/boundary-conditions.md).
-    for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
     for (int j = 1; j < k; ++j) {
       lumped_projection(out, grid_proj_);
       for_each_node(n_slots(), [&](std::int32_t i) { out[i] += grid_term_[i] - grid_proj_[i]; });
@@ -438,7 +438,6 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
     }
     return;
   }
-  for_each_node(n_slots(), [&](std::int32_t i) { out[i] = grid_term_[i]; });
   for (int j = 1; j < k; ++j) {
     lumped_projection(grid_term_, grid_proj_);
     for_each_node(n_slots(), [&](std::int32_t i) {
