@@ -7,6 +7,23 @@
 namespace cairn {
 
 namespace {
+/// Position of an assignment operator (=, +=, -=, *=, /=) in `text`, or npos. muParser would
+/// store into a variable (`t=1e9` sets the time); comparisons ==, <=, >=, != are fine.
+std::size_t assignment_at(const std::string& text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '=') continue;
+    const char before = i > 0 ? text[i - 1] : ' ';
+    const char after = i + 1 < text.size() ? text[i + 1] : ' ';
+    if (after == '=') {  // "==": skip both characters
+      ++i;
+      continue;
+    }
+    if (before == '<' || before == '>' || before == '!') continue;
+    return i;
+  }
+  return std::string::npos;
+}
+
 /// Triangular pulse of full width w, peak 1 at t = w / 2, zero outside 0 < t < w (seed 000
 /// Sec. 3.3, tri(t, dt)).
 double tri(double t, double w) {
@@ -36,12 +53,27 @@ Expression::Expression(const std::string& text, const Constants& constants)
     parser_->DefineFun("tri", tri);
     parser_->DefineFun("ramp", ramp);
     for (const auto& [name, value] : constants) parser_->DefineConst(name, value);
+    if (const auto at = assignment_at(text); at != std::string::npos) {
+      const bool compound = at > 0 && std::string("+-*/").find(text[at - 1]) != std::string::npos;
+      throw std::invalid_argument("expression \"" + text + "\": the assignment '" +
+                                  text.substr(compound ? at - 1 : at, compound ? 2 : 1) +
+                                  "' is not allowed (an input expression only computes a value)");
+    }
     parser_->SetExpr(text);
     const auto used = parser_->GetUsedVar();  // also checks the syntax
+    for (const auto& [name, ptr] : used) used_.push_back(name);
     constant_ = used.empty();
     uses_x_ = used.count("x") || used.count("y") || used.count("z");
     uses_position_ = uses_x_ || used.count("X") || used.count("Y") || used.count("Z");
     parser_->Eval();
+    // muParser's ',' outside a function's arguments separates expressions and Eval() returns
+    // the last: "-9,81" would be 81.
+    if (parser_->GetNumResults() > 1)
+      throw std::invalid_argument(
+          "expression \"" + text + "\": ',' outside a function's arguments makes " +
+          std::to_string(parser_->GetNumResults()) +
+          " separate expressions of which only the last would count; write one expression "
+          "(a decimal point is '.')");
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument("expression \"" + text + "\": " + e.GetMsg());
   }
