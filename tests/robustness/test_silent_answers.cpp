@@ -66,6 +66,9 @@ TEST(Robustness, ExpressionsRejectCommaAndAssignment) {
   r = cairn_on("check", base_input() + "[body_force]\nexpression = [0.0, \"t=1e9\"]\n", d);
   EXPECT_TRUE(input_error(r, "case.toml:23", "body_force.expression[1]"));
   EXPECT_NE(r.output.find("assignment"), std::string::npos) << r.output;
+  // The contact law's slide expression has its own variables and the same rules.
+  r = cairn_on("check", base_input() + "[contact]\nmode = \"body\"\nlaw = \"general\"\nslide = \"vslip, 1\"\n", d);
+  EXPECT_TRUE(input_error(r, "case.toml:25", "contact.slide"));
   // A syntax error names file, line and key (it used to give muParser's message alone).
   r = cairn_on("check", base_input() + "[body_force]\nexpression = [0.0, \"-9.81*(\"]\n", d);
   EXPECT_TRUE(input_error(r, "case.toml:23", "body_force.expression[1]"));

@@ -2,6 +2,7 @@
 
 #include <muParser.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace cairn {
@@ -39,6 +40,40 @@ double ramp(double t, double r) {
 }
 }  // namespace
 
+namespace {
+/// Functions and constants every input expression has.
+void define_common(mu::Parser& parser, const Constants& constants) {
+  parser.DefineConst("pi", 3.141592653589793238462643383279502884);
+  parser.DefineFun("tri", tri);
+  parser.DefineFun("ramp", ramp);
+  for (const auto& [name, value] : constants) parser.DefineConst(name, value);
+}
+
+/// Set `text` on `parser` (variables defined) and evaluate it once, refusing what muParser
+/// accepts but an input must not have. Returns the variables it uses.
+std::vector<std::string> compile(mu::Parser& parser, const std::string& text) {
+  if (const auto at = assignment_at(text); at != std::string::npos) {
+    const bool compound = at > 0 && std::string("+-*/").find(text[at - 1]) != std::string::npos;
+    throw std::invalid_argument("expression \"" + text + "\": the assignment '" +
+                                text.substr(compound ? at - 1 : at, compound ? 2 : 1) +
+                                "' is not allowed (an input expression only computes a value)");
+  }
+  parser.SetExpr(text);
+  std::vector<std::string> used;
+  for (const auto& [name, ptr] : parser.GetUsedVar()) used.push_back(name);  // also checks the syntax
+  parser.Eval();
+  // muParser's ',' outside a function's arguments separates expressions and Eval() returns
+  // the last: "-9,81" would be 81.
+  if (parser.GetNumResults() > 1)
+    throw std::invalid_argument(
+        "expression \"" + text + "\": ',' outside a function's arguments makes " +
+        std::to_string(parser.GetNumResults()) +
+        " separate expressions of which only the last would count; write one expression "
+        "(a decimal point is '.')");
+  return used;
+}
+}  // namespace
+
 Expression::Expression(const std::string& text, const Constants& constants)
     : text_(text), parser_(std::make_unique<mu::Parser>()) {
   try {
@@ -49,31 +84,25 @@ Expression::Expression(const std::string& text, const Constants& constants)
     parser_->DefineVar("Y", &Y_);
     parser_->DefineVar("Z", &Z_);
     parser_->DefineVar("t", &t_);
-    parser_->DefineConst("pi", 3.141592653589793238462643383279502884);
-    parser_->DefineFun("tri", tri);
-    parser_->DefineFun("ramp", ramp);
-    for (const auto& [name, value] : constants) parser_->DefineConst(name, value);
-    if (const auto at = assignment_at(text); at != std::string::npos) {
-      const bool compound = at > 0 && std::string("+-*/").find(text[at - 1]) != std::string::npos;
-      throw std::invalid_argument("expression \"" + text + "\": the assignment '" +
-                                  text.substr(compound ? at - 1 : at, compound ? 2 : 1) +
-                                  "' is not allowed (an input expression only computes a value)");
-    }
-    parser_->SetExpr(text);
-    const auto used = parser_->GetUsedVar();  // also checks the syntax
-    for (const auto& [name, ptr] : used) used_.push_back(name);
-    constant_ = used.empty();
-    uses_x_ = used.count("x") || used.count("y") || used.count("z");
-    uses_position_ = uses_x_ || used.count("X") || used.count("Y") || used.count("Z");
-    parser_->Eval();
-    // muParser's ',' outside a function's arguments separates expressions and Eval() returns
-    // the last: "-9,81" would be 81.
-    if (parser_->GetNumResults() > 1)
-      throw std::invalid_argument(
-          "expression \"" + text + "\": ',' outside a function's arguments makes " +
-          std::to_string(parser_->GetNumResults()) +
-          " separate expressions of which only the last would count; write one expression "
-          "(a decimal point is '.')");
+    define_common(*parser_, constants);
+    used_ = compile(*parser_, text);
+    const auto uses = [&](const char* v) { return std::find(used_.begin(), used_.end(), v) != used_.end(); };
+    constant_ = used_.empty();
+    uses_x_ = uses("x") || uses("y") || uses("z");
+    uses_position_ = uses_x_ || uses("X") || uses("Y") || uses("Z");
+  } catch (const mu::Parser::exception_type& e) {
+    throw std::invalid_argument("expression \"" + text + "\": " + e.GetMsg());
+  }
+}
+
+void Expression::check(const std::string& text, const std::vector<std::string>& variables,
+                       const Constants& constants) {
+  mu::Parser parser;
+  std::vector<double> values(variables.size(), 0.0);
+  try {
+    for (std::size_t i = 0; i < variables.size(); ++i) parser.DefineVar(variables[i], &values[i]);
+    define_common(parser, constants);
+    compile(parser, text);
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument("expression \"" + text + "\": " + e.GetMsg());
   }

@@ -32,6 +32,10 @@ class Expression {
   /// a ',' outside a function's arguments (`-9,81`, which muParser evaluates to 81).
   Expression(const std::string& text, const Constants& constants);
   ~Expression();
+  /// Compile `text` with the variables `variables` (for keys with their own, such as a contact
+  /// law's slide expression) and throw as the constructor does.
+  static void check(const std::string& text, const std::vector<std::string>& variables,
+                    const Constants& constants);
   Expression(const Expression&) = delete;
   Expression& operator=(const Expression&) = delete;
 

@@ -47,7 +47,8 @@ enum class ExpressionVars {
   initial,   ///< x, y, z, X, Y, Z up to the dimension: evaluated once, at t = 0 (body velocity)
   field,     ///< positions and t (body force)
   time,      ///< t only (time functions of loads, velocity conditions and walls)
-  unchecked, ///< a key with its own variables, compiled by its user (contact slide)
+  slide,     ///< Nc, vslip, t: the general contact law's slide expression
+  unchecked, ///< read as text: the caller checks it (a wall gradient may be a word)
 };
 
 Path child(Path p, std::string part) {
@@ -652,6 +653,15 @@ std::vector<std::vector<double>> TableReader::points(const std::string& name, st
 void Loader::check_expression(const Path& path, const toml::node* node, const std::string& text,
                               ExpressionVars vars) const {
   if (vars == ExpressionVars::unchecked) return;
+  if (vars == ExpressionVars::slide) {
+    const std::vector<std::string> slide_vars{"Nc", "vslip", "t"};
+    try {
+      Expression::check(text, slide_vars, constants_);
+    } catch (const std::invalid_argument& err) {
+      fail(path, node, "one expression in Nc, vslip, t and [constants]", err.what());
+    }
+    return;
+  }
   std::vector<std::string> allowed;
   if (vars != ExpressionVars::time) {
     for (int a = 0; a < dim_; ++a) allowed.emplace_back(1, "xyz"[a]);
@@ -1467,7 +1477,7 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
     law.law = lr.string("law");
     law.friction = lr.real("friction");
     law.dynamic_friction = lr.real("dynamic_friction");
-    law.slide = lr.expression("slide", ExpressionVars::unchecked);
+    law.slide = lr.expression("slide", ExpressionVars::slide);
     return law;
   };
   c.law = read_law(r);
