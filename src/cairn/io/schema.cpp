@@ -231,7 +231,7 @@ std::vector<KeyDecl> make_declarations() {
                 .max(16));
   k.push_back(Key("body", "velocity", T::expression_array,
                  "Initial velocity, one entry per axis: numbers or expressions in X, Y, Z "
-                 "(reference position) and [constants]; default zeros."));
+                 "(reference position) and [constants], evaluated once (no t); default zeros."));
   k.push_back(Key("body", "displacement", T::expression_array,
                  "Initial displacement field, entries as for velocity (F is set from its "
                  "gradient); default none."));

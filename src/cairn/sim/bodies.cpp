@@ -93,8 +93,10 @@ void check_overlaps(const Config& config, const Particles<D>& particles, const s
                          (bounds[b].hi.array() < bounds[a].lo.array()).any();
       if (apart) continue;
       std::size_t shared = 0;
-      for (std::size_t p = first_of[b]; p < first_of[b + 1]; ++p)
-        if (inside<D>(config.bodies[a].shape, images[a].get(), particles.reference_position[p])) ++shared;
+      for (std::size_t p = first_of[b]; p < first_of[b + 1]; ++p)  // (zero-volume particles carry no mass)
+        if (particles.volume0[p] > 0.0 &&
+            inside<D>(config.bodies[a].shape, images[a].get(), particles.reference_position[p]))
+          ++shared;
       if (shared == 0) continue;
       const BodyConfig& first = config.bodies[a];
       const BodyConfig& second = config.bodies[b];
