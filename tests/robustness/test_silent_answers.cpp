@@ -103,6 +103,17 @@ TEST(Robustness, ExtremePhysicalValuesWarn) {
   EXPECT_EQ(cairn_on("check", base_input(), d).output.find("warning"), std::string::npos);
 }
 
+TEST(Robustness, EmptySelectionsNameKeyExpectedAndFound) {
+  const fs::path d = case_dir("empty_selection");
+  // A plane between the nodes, and a box around no particle face.
+  CliResult r = cairn_on("check", base_input() + "[[velocity]]\nplane_axis = \"x\"\nplane_at = 0.55\n"
+                                                 "direction = [1.0, 0.0]\n", d);
+  EXPECT_TRUE(input_error(r, "case.toml:22", "velocity[0]"));
+  r = cairn_on("check", base_input() + "[[traction]]\nbox_min = [0.0, 0.0]\nbox_max = [0.1, 0.1]\n"
+                                       "traction = [1.0, 0.0]\n", d);
+  EXPECT_TRUE(input_error(r, "case.toml:22", "traction[0]"));
+}
+
 TEST(Robustness, BodyWithoutParticlesNamesKeyExpectedAndFound) {
   const fs::path d = case_dir("no_particle");
   // A box thinner than the particle spacing between two lattice rows.
