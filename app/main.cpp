@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
   run->add_option("input", input, "input file")->required();
   run->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
   run->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  run->add_option("-t,--threads", threads, "OpenMP threads, 1..1024 (default or 0: all cores)")
+  run->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
       ->check(CLI::Range(0, max_threads));
 
   auto* check = app.add_subcommand("check", "validate an input file and print the resolved settings");
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
   restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
   restart->add_option("--set", overrides, "override an input key of the stored input");
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  restart->add_option("-t,--threads", threads, "OpenMP threads, 1..1024 (default or 0: all cores)")
+  restart->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
       ->check(CLI::Range(0, max_threads));
 
   try {
