@@ -210,7 +210,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   // particle whose box does not fit sends the build through the sizing pass and a second try
   // (rare: the stride only grows).
   int slots = 1, widest = 1;
-  bool sized = !(cache.stride > 0 && cache.count.size() == particles.n());
+  bool sized = !(cache.layout == StencilLayout::list && cache.stride > 0 && cache.n == particles.n());
   if (!sized) {
     slots = cache.stride;
     widest = cache.stride;

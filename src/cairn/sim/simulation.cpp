@@ -234,7 +234,6 @@ template <int D>
 void Simulation<D>::build_stencils() {
   shape_->build(grid_, particles_, cache_);
   colour_blocks(grid_, cache_);
-  if (contact_) contact_->fill_slots(particles_, cache_);
 }
 
 template <int D>
@@ -272,7 +271,6 @@ template <int D>
 void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   const bool has_body_force = !body_force_.empty();
   const bool affine = scheme_->affine();
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) {
     if (mass_and_momentum) {
       nodes_.mass[i] = 0.0;
@@ -287,26 +285,29 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   if (forces) compute_body_forces();
   const auto& P = particles_;
   // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    const std::int32_t i = idx[s];
-    const double Sm = cache_.weight[s] * P.mass[p];
-    if (mass_and_momentum) {
-      nodes_.mass[i] += Sm;
-      if (affine) {
-        const Vec<D> dx = node_offset(grid_, cache_.node[s], P.position[p]);
-        nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
-      } else {
-        nodes_.momentum[i] += Sm * P.velocity[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+      const std::int32_t i = node + off;
+      const double Sm = S * P.mass[p];
+      if (mass_and_momentum) {
+        nodes_.mass[i] += Sm;
+        if (affine) {
+          const Vec<D> dx = node_offset(grid_, node, P.position[p]);
+          nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+        } else {
+          nodes_.momentum[i] += Sm * P.velocity[p];
+        }
       }
-    }
-    if (forces) {
-      nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * cache_.gradient[s]);
-      if (has_body_force) {
-        const Vec<D> fb = Sm * body_acceleration_[p];
-        nodes_.force[i] += fb;
-        node_body_force_[i] += fb;
+      if (forces) {
+        nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * G);
+        if (has_body_force) {
+          const Vec<D> fb = Sm * body_acceleration_[p];
+          nodes_.force[i] += fb;
+          node_body_force_[i] += fb;
+        }
       }
-    }
+    });
   });
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
@@ -381,15 +382,18 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     Vec<D> u = Vec<D>::Zero();
-    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[idx[s]];
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { u += S * in[node + off]; });
     particle_vec_[p] = u;
   });
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    out[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      out[node + off] += (S * particles_.mass[p]) * particle_vec_[p];
+    });
   });
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
@@ -495,10 +499,12 @@ void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& mom
 
 template <int D>
 void Simulation<D>::reextrapolate_momentum() {
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) { grid_term_[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    grid_term_[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      grid_term_[node + off] += (S * particles_.mass[p]) * particles_.velocity[p];
+    });
   });
   if (contact_)  // the re-extrapolated momenta obey contact too (same normals and separations)
     contact_->correct(nodes_.mass, grid_term_, true, Contact<D>::Pass::stress, time_, step_dt_, nullptr);
@@ -517,16 +523,15 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::int32_t i = idx[s];
-      const double S = cache_.weight[s];
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      const std::int32_t i = node + off;
       g.Sv += S * v[i];
       g.Sv_new += S * v_new[i];
       if (full) g.Sv_full += S * v_full[i];
-    }
+    });
     if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
@@ -542,11 +547,11 @@ void Simulation<D>::update_particles(double dt) {
       // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
       // for every shape family (D = h^2/4 I for quadratic splines).
       Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
-      for (std::size_t s = begin; s < end; ++s) {
-        const Vec<D> d = node_offset(grid_, cache_.node[s], x_old);
-        B += cache_.weight[s] * v_new[idx[s]] * d.transpose();
-        Dp += cache_.weight[s] * d * d.transpose();
-      }
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+        const Vec<D> d = node_offset(grid_, node, x_old);
+        B += S * v_new[node + off] * d.transpose();
+        Dp += S * d * d.transpose();
+      });
       P.affine_velocity[p].setZero();
       P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
     }
@@ -576,11 +581,12 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     Mat3 L = Mat3::Zero();
-    for (std::size_t s = begin; s < end; ++s)
-      L.template topLeftCorner<D, D>() += grid_velocity[idx[s]] * cache_.gradient[s].transpose();
+    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
+      L.template topLeftCorner<D, D>() += grid_velocity[node + off] * G.transpose();
+    });
     particles_.velocity_gradient[p] = L;
     Mat3& F = particles_.deformation_gradient[p];
     const Mat3 dF = tensor_exp(L * dt);

@@ -119,8 +119,8 @@ class Simulation {
   void subtract_contact_term(std::vector<Vec<D>>& out, int k);
   /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
   [[nodiscard]] std::int32_t n_slots() const { return grid_.n_nodes() * n_fields_; }
-  /// Per stencil entry, the index into the node arrays (cache.slot in multimaterial mode).
-  [[nodiscard]] const std::int32_t* slots() const { return contact_ ? cache_.slot.data() : cache_.node.data(); }
+  /// Offset of particle p's field in the node arrays (multimaterial mode; 0 otherwise).
+  [[nodiscard]] std::int32_t field_offset(std::int64_t p) const { return contact_ ? field_offset_[p] : 0; }
   /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
   /// with the values of the start or the end of the step.
   void impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when);

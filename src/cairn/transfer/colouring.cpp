@@ -24,7 +24,7 @@ void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
   }
   const int total_blocks = n_blocks.prod();
   const int total_colours = n_colours.prod();
-  const auto n = static_cast<std::int64_t>(cache.count.size());
+  const auto n = static_cast<std::int64_t>(cache.n);
 
   auto block_along = [&](int a, int c) {
     const int nc = grid.n_cells()[a];
