@@ -97,11 +97,11 @@ void check_family(const std::string& name, bool periodic, double deform) {
     }
     // The colouring reach must cover every node of the stencil (or P2G would race).
     if (!periodic)
-      for_each_entry(cache, p, [&](std::int32_t node, double, const Vec<D>&) {
+      for_each_entry(cache, p, [&, cell = grid.cell_of(parts.position[p])](std::int32_t node, double, const Vec<D>&) {
         const IVec<D> j = grid.multi_index(node);
         for (int a = 0; a < D; ++a) {
-          EXPECT_GE(j[a], cache.cell[p][a] - cache.reach_lo[a]) << what << " p=" << p;
-          EXPECT_LE(j[a], cache.cell[p][a] + 1 + cache.reach_hi[a]) << what << " p=" << p;
+          EXPECT_GE(j[a], cell[a] - cache.reach_lo[a]) << what << " p=" << p;
+          EXPECT_LE(j[a], cell[a] + 1 + cache.reach_hi[a]) << what << " p=" << p;
         }
       });
   }

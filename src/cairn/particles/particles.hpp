@@ -21,14 +21,17 @@ struct Particles {
   std::vector<Vec<D>> size0;            ///< initial particle edge lengths l_p0 (domain size)
   std::vector<Mat3> deformation_gradient;  ///< F (3x3 always)
   std::vector<Mat3> kirchhoff_stress;   ///< tau = J sigma (3x3 always)
-  std::vector<Mat3> velocity_gradient;  ///< last grad V_p extrapolated from the grid (diagnostic)
-  std::vector<Mat3> affine_velocity;    ///< APIC affine matrix C_p (top-left DxD used; else zero)
+  /// APIC affine matrix C_p (top-left DxD used); stored only when has_affine, else empty.
+  std::vector<Mat3> affine_velocity;
   std::vector<double> temperature;      ///< temperature (thermal models; 0 where unused)
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
   std::vector<double> state;
   int n_state_per_particle = 0;
+  /// Whether affine_velocity is stored (the simulation sets it from its scheme before adding
+  /// particles; schemes without an affine part leave the 72 bytes per particle unallocated).
+  bool has_affine = true;
 
   [[nodiscard]] std::size_t n() const { return position.size(); }
 
@@ -41,12 +44,28 @@ struct Particles {
     size0.resize(n);
     deformation_gradient.resize(n, Mat3::Identity());
     kirchhoff_stress.resize(n, Mat3::Zero());
-    velocity_gradient.resize(n, Mat3::Zero());
-    affine_velocity.resize(n, Mat3::Zero());
+    affine_velocity.resize(has_affine ? n : 0, Mat3::Zero());
     temperature.resize(n, 0.0);
     material.resize(n);
     body.resize(n);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
+  }
+
+  /// Release the spare capacity that adding particles one by one leaves (up to half the arrays).
+  void shrink_to_fit() {
+    position.shrink_to_fit();
+    reference_position.shrink_to_fit();
+    velocity.shrink_to_fit();
+    mass.shrink_to_fit();
+    volume0.shrink_to_fit();
+    size0.shrink_to_fit();
+    deformation_gradient.shrink_to_fit();
+    kirchhoff_stress.shrink_to_fit();
+    affine_velocity.shrink_to_fit();
+    temperature.shrink_to_fit();
+    material.shrink_to_fit();
+    body.shrink_to_fit();
+    state.shrink_to_fit();
   }
 
   /// Append one particle; F = I, zero stress.
@@ -60,8 +79,7 @@ struct Particles {
     size0.push_back(lp0);
     deformation_gradient.push_back(Mat3::Identity());
     kirchhoff_stress.push_back(Mat3::Zero());
-    velocity_gradient.push_back(Mat3::Zero());
-    affine_velocity.push_back(Mat3::Zero());
+    if (has_affine) affine_velocity.push_back(Mat3::Zero());
     temperature.push_back(0.0);
     material.push_back(mat);
     body.push_back(bod);

@@ -251,7 +251,6 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       const Domain dom = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span);
       IVec<D> cell;
       for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(dom.xi[a]));
-      cache.cell[p] = cell;
       // The common case takes the fixed (n_nodes + 1)^D box; stretched domains, the fallback and
       // a stride sized for smaller boxes take the general box of dom.dims.
       const bool fixed = !dom.fallback && dom.dims.maxCoeff() <= Fixed::width &&

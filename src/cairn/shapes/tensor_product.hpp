@@ -63,7 +63,6 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
         cell[a] = static_cast<int>(std::floor(xi[a]));
         first[a] = kernel.eval(particles, p, a, xi[a], w[a].data(), dw[a].data());
       }
-      cache.cell[p] = cell;
       // Per-axis storage offsets of the stencil nodes (-1: beyond the ghost layers).
       std::array<std::array<std::int32_t, max_width>, D> offset{};
       for (int a = 0; a < D; ++a)

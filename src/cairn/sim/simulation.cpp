@@ -55,7 +55,9 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
+  particles_.has_affine = scheme_->affine();
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
+  particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
   if (config_.thermal.conduction) {
     std::vector<double> k, cp;
@@ -79,14 +81,18 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     field_offset_.resize(particles_.n());
     for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
   }
-  nodes_.resize(n_slots());
-  grid_term_.assign(n_slots(), Vec<D>::Zero());
-  grid_proj_.assign(n_slots(), Vec<D>::Zero());
-  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
-  particle_scalar_.assign(particles_.n(), 0.0);
-  body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
+  // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
+  // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
+  const bool node_scratch = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
+  nodes_.resize(n_slots(), node_scratch);
+  if (node_scratch) {
+    grid_term_.assign(n_slots(), Vec<D>::Zero());
+    grid_proj_.assign(n_slots(), Vec<D>::Zero());
+  }
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
+  if (conditions_.empty() && velocity_conditions_.empty())
+    std::vector<Vec<D>>().swap(nodes_.reaction);  // nothing records reactions
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
   if (!config_.body_force.expression.empty()) {
@@ -173,6 +179,10 @@ void Simulation<D>::step(double dt) {
       next_full_mass_time_ = time_ + config_.method.full_mass_cfl * grid_.min_cell_size() / max_signal_speed();
   }
   const bool fmpm_velocities = use_full_mass_ && need == FullMass::of_updated;
+  if (scheme_->affine() && particles_.affine_velocity.size() != particles_.n()) {
+    particles_.has_affine = true;  // e.g. restarted with APIC from a checkpoint without C_p
+    particles_.affine_velocity.assign(particles_.n(), Mat3::Zero());
+  }
   const int k = config_.method.order;
   step_dt_ = dt;
 
@@ -233,17 +243,15 @@ void Simulation<D>::step(double dt) {
 template <int D>
 void Simulation<D>::build_stencils() {
   shape_->build(grid_, particles_, cache_);
-  colour_blocks(grid_, cache_);
+  colour_blocks(grid_, particles_, cache_);
 }
 
 template <int D>
 void Simulation<D>::compute_body_forces() {
   if (body_force_.empty()) return;
   const auto n = static_cast<std::int64_t>(particles_.n());
-  if (body_force_constant_) {
-    std::fill(body_acceleration_.begin(), body_acceleration_.end(), body_force_value_);
-    return;
-  }
+  if (body_force_constant_) return;  // particles_to_grid reads body_force_value_
+  body_acceleration_.resize(particles_.n());
 #pragma omp parallel
   {
     auto& expr = *body_force_[omp_get_thread_num()];
@@ -280,7 +288,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       nodes_.force[i].setZero();
       if (has_body_force) node_body_force_[i].setZero();
     }
-    nodes_.reaction[i].setZero();
+    if (!nodes_.reaction.empty()) nodes_.reaction[i].setZero();
   });
   if (forces) compute_body_forces();
   const auto& P = particles_;
@@ -302,7 +310,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       if (forces) {
         nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * G);
         if (has_body_force) {
-          const Vec<D> fb = Sm * body_acceleration_[p];
+          const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
           nodes_.force[i] += fb;
           node_body_force_[i] += fb;
         }
@@ -372,7 +380,7 @@ void Simulation<D>::update_grid(double dt) {
   if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
     external_work_ += dt * chunked_sum<double>(n_slots(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
-      double w = nodes_.reaction[i].dot(v_mean);
+      double w = nodes_.reaction.empty() ? 0.0 : nodes_.reaction[i].dot(v_mean);
       if (has_body_force) w += node_body_force_[i].dot(v_mean);
       return w;
     });
@@ -382,6 +390,7 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
+  particle_vec_.resize(particles_.n());
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
     Vec<D> u = Vec<D>::Zero();
@@ -523,7 +532,9 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+  // The sum is the energy dissipated relative to the non-dissipative FLIP update (seed 002
+  // Eq. 1.50).
+  dissipated_energy_ += gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
     GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
     stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
@@ -536,9 +547,8 @@ void Simulation<D>::update_particles(double dt) {
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
     const Vec<D> x_old = P.position[p];
     P.velocity[p] += e.A_dt;
     P.position[p] += dX;
@@ -555,9 +565,8 @@ void Simulation<D>::update_particles(double dt) {
       P.affine_velocity[p].setZero();
       P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
     }
+    return dissipated;
   });
-  dissipated_energy_ += chunked_sum<double>(static_cast<std::int64_t>(P.n()), 0.0,
-                                            [&](std::int64_t p) { return particle_scalar_[p]; });
 }
 
 template <int D>
@@ -587,7 +596,6 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
     stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
       L.template topLeftCorner<D, D>() += grid_velocity[node + off] * G.transpose();
     });
-    particles_.velocity_gradient[p] = L;
     Mat3& F = particles_.deformation_gradient[p];
     const Mat3 dF = tensor_exp(L * dt);
     F = dF * F;
@@ -631,7 +639,7 @@ NodeField<D> Simulation<D>::grid_totals() const {
       t.force[i] += nodes_.force[s];
       t.velocity_new[i] += nodes_.mass[s] * nodes_.velocity_new[s];
       t.velocity[i] += nodes_.mass[s] * nodes_.velocity[s];
-      t.reaction[i] += nodes_.reaction[s];
+      if (!nodes_.reaction.empty()) t.reaction[i] += nodes_.reaction[s];
     }
     if (t.mass[i] > small_mass_) {
       t.velocity_new[i] /= t.mass[i];

@@ -141,8 +141,7 @@ class Simulation {
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
-  std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles
-  std::vector<double> particle_scalar_;    ///< scratch: per-particle dissipation of the step
+  std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)
   double dissipated_energy_ = 0.0;
   double step_dt_ = 0.0;
   double next_full_mass_time_ = 0.0;
@@ -150,7 +149,7 @@ class Simulation {
   std::vector<std::unique_ptr<ExpressionVector<D>>> body_force_;  ///< one per thread
   bool body_force_constant_ = false;
   Vec<D> body_force_value_ = Vec<D>::Zero();
-  std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step
+  std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step (body forces that vary)
   GridConditions<D> conditions_;           ///< velocity conditions from [boundary]
   VelocityConditions<D> velocity_conditions_;  ///< [[velocity]] and [[wall]]
   Tractions<D> tractions_;                 ///< [[traction]]

@@ -42,10 +42,9 @@ struct TransferCache {
   /// n*D*2*width: per axis the weights phi(k), then the derivatives dphi(k)/dx (physical units)
   std::vector<double> axis_value;
 
-  std::vector<IVec<D>> cell;         ///< cell holding each particle (for colouring)
-
-  /// Stencil reach in cells beyond the particle's cell, per axis: nodes from cell - reach_lo
-  /// to cell + 1 + reach_hi. Reported by the family so that colouring blocks are wide enough.
+  /// Stencil reach in cells beyond the cell holding the particle (floor of its position in cell
+  /// units, grid.cell_of), per axis: nodes from cell - reach_lo to cell + 1 + reach_hi. Reported
+  /// by the family so that colouring blocks are wide enough.
   IVec<D> reach_lo = IVec<D>::Zero();
   IVec<D> reach_hi = IVec<D>::Zero();
 
@@ -84,7 +83,6 @@ struct TransferCache {
 
  private:
   void resize_common() {
-    cell.assign(n, IVec<D>::Zero());
     block_of.assign(n, 0);
     order.assign(n, 0);
   }

@@ -13,18 +13,21 @@
 // the number of threads, so results are bit-identical for any OMP_NUM_THREADS.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 
 namespace cairn {
 
-/// Bin particles into coloured cell blocks using cache.cell and the reach reported by the shape
-/// family. Call after every stencil build. Allocation-free once sized.
+/// Bin particles into coloured cell blocks by the cell holding each particle (grid.cell_of) and
+/// the reach reported by the shape family. Call after every stencil build. Allocation-free once
+/// sized.
 template <int D>
-void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache);
+void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferCache<D>& cache);
 
 /// One particle's stencil in the list layout.
 template <int D>
@@ -144,14 +147,44 @@ void scatter(const TransferCache<D>& cache, Fn&& fn) {
   });
 }
 
-/// Gather: calls fn(p, stencil) for every particle in parallel.
+/// Particles per work chunk of a gather. Fixed, so that sums taken chunk by chunk do not depend
+/// on the thread count; small, so that threads share the work evenly when one of them is slowed
+/// down by another process on its core (chunks are handed out dynamically).
+inline constexpr std::int64_t gather_chunk = 512;
+
+/// Gather: calls fn(p, stencil) for every particle, in parallel over chunks of particles.
 template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
   with_stencils(cache, [&](auto stencil_of) {
     const auto n = static_cast<std::int64_t>(cache.n);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t p = 0; p < n; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
+    const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
+    }
   });
+}
+
+/// Gather that also returns sum_p fn(p, stencil): a running sum within each chunk, the chunks'
+/// sums added in chunk order, so the total is the same for any thread count.
+template <int D, class Fn>
+double gather_sum(const TransferCache<D>& cache, Fn&& fn) {
+  const auto n = static_cast<std::int64_t>(cache.n);
+  const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+  std::vector<double> partial(static_cast<std::size_t>(n_chunks), 0.0);
+  with_stencils(cache, [&](auto stencil_of) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      double sum = 0.0;
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) sum += fn(p, stencil_of(static_cast<std::size_t>(p)));
+      partial[static_cast<std::size_t>(c)] = sum;
+    }
+  });
+  double total = 0.0;
+  for (double s : partial) total += s;
+  return total;
 }
 
 /// Parallel loop over nodes.
