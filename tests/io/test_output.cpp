@@ -127,6 +127,12 @@ void expect_mats_identical(const std::vector<Mat3>& a, const std::vector<Mat3>& 
   }
 }
 
+void expect_mats_identical(const std::vector<SymMat3>& a, const std::vector<SymMat3>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t p = 0; p < a.size(); ++p)
+    for (int k = 0; k < 6; ++k) EXPECT_TRUE(same_bits(a[p].voigt()[k], b[p].voigt()[k])) << what << " particle " << p;
+}
+
 template <int D>
 void expect_particles_identical(const Particles<D>& a, const Particles<D>& b) {
   EXPECT_EQ(a.n_state_per_particle, b.n_state_per_particle);

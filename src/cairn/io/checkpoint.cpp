@@ -42,6 +42,14 @@ void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m) 
   });
 }
 
+void write_mats(hid_t loc, const std::string& name, const std::vector<SymMat3>& m) {
+  h5::write_doubles_blocked(loc, name, m.size(), 9, [&](std::size_t first, std::size_t count, double* out) {
+    for (std::size_t p = first; p < first + count; ++p)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
+  });
+}
+
 std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
   const std::vector<double> buffer = h5::read_doubles(loc, name, {n, 9});
   std::vector<Mat3> m(n);
@@ -58,7 +66,7 @@ void check_particles(const Particles<D>& ps) {
                   ps.mass.size() == n && ps.volume0.size() == n && ps.size0.size() == n &&
                   ps.deformation_gradient.size() == n && ps.kirchhoff_stress.size() == n &&
                   ps.affine_velocity.size() == (ps.has_affine ? n : 0) &&
-                  ps.temperature.size() == n &&
+                  ps.temperature.size() == (ps.has_temperature ? n : 0) &&
                   ps.material.size() == n &&
                   ps.body.size() == n && ps.n_state_per_particle >= 0 &&
                   ps.state.size() == n * static_cast<std::size_t>(ps.n_state_per_particle);
@@ -176,7 +184,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
       write_vecs<D>(gid, "velocity", ps.velocity);
       h5::write_doubles(gid, "mass", ps.mass.data(), n);
       h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
-      h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
+      if (ps.has_temperature) h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
       write_vecs<D>(gid, "size0", ps.size0);
       write_mats(gid, "deformation_gradient", ps.deformation_gradient);
       write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
@@ -247,10 +255,12 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
     ps.velocity = read_vecs<D>(gid, "velocity", n);
     ps.mass = h5::read_doubles(gid, "mass", {n});
     ps.volume0 = h5::read_doubles(gid, "volume0", {n});
-    ps.temperature = h5::read_doubles(gid, "temperature", {n});
+    ps.has_temperature = h5::has_child(gid, "temperature");
+    if (ps.has_temperature) ps.temperature = h5::read_doubles(gid, "temperature", {n});
     ps.size0 = read_vecs<D>(gid, "size0", n);
     ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
-    ps.kirchhoff_stress = read_mats(gid, "kirchhoff_stress", n);
+    const std::vector<Mat3> tau = read_mats(gid, "kirchhoff_stress", n);
+    ps.kirchhoff_stress.assign(tau.begin(), tau.end());
     // APIC runs store C_p; others leave it out (older files also hold velocity_gradient,
     // which is recomputed every step and not read).
     ps.has_affine = h5::has_child(gid, "affine_velocity");

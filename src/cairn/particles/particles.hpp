@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "cairn/math/sym_mat3.hpp"
 #include "cairn/math/types.hpp"
 
 namespace cairn {
@@ -20,10 +21,10 @@ struct Particles {
   std::vector<double> volume0;          ///< initial volume V_p^(0) (x thickness in 2D)
   std::vector<Vec<D>> size0;            ///< initial particle edge lengths l_p0 (domain size)
   std::vector<Mat3> deformation_gradient;  ///< F (3x3 always)
-  std::vector<Mat3> kirchhoff_stress;   ///< tau = J sigma (3x3 always)
+  std::vector<SymMat3> kirchhoff_stress;  ///< tau = J sigma (symmetric, six components)
   /// APIC affine matrix C_p (top-left DxD used); stored only when has_affine, else empty.
   std::vector<Mat3> affine_velocity;
-  std::vector<double> temperature;      ///< temperature (thermal models; 0 where unused)
+  std::vector<double> temperature;      ///< temperature; stored only when has_temperature
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
@@ -32,6 +33,9 @@ struct Particles {
   /// Whether affine_velocity is stored (the simulation sets it from its scheme before adding
   /// particles; schemes without an affine part leave the 72 bytes per particle unallocated).
   bool has_affine = true;
+  /// Whether temperature is stored (thermal models, conduction); the simulation sets it like
+  /// has_affine. Without it the array stays empty and temperatures read as 0.
+  bool has_temperature = true;
 
   [[nodiscard]] std::size_t n() const { return position.size(); }
 
@@ -43,9 +47,9 @@ struct Particles {
     volume0.resize(n);
     size0.resize(n);
     deformation_gradient.resize(n, Mat3::Identity());
-    kirchhoff_stress.resize(n, Mat3::Zero());
+    kirchhoff_stress.resize(n);
     affine_velocity.resize(has_affine ? n : 0, Mat3::Zero());
-    temperature.resize(n, 0.0);
+    temperature.resize(has_temperature ? n : 0, 0.0);
     material.resize(n);
     body.resize(n);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
@@ -78,9 +82,9 @@ struct Particles {
     volume0.push_back(vol0);
     size0.push_back(lp0);
     deformation_gradient.push_back(Mat3::Identity());
-    kirchhoff_stress.push_back(Mat3::Zero());
+    kirchhoff_stress.emplace_back();
     if (has_affine) affine_velocity.push_back(Mat3::Zero());
-    temperature.push_back(0.0);
+    if (has_temperature) temperature.push_back(0.0);
     material.push_back(mat);
     body.push_back(bod);
     state.resize(state.size() + static_cast<std::size_t>(n_state_per_particle), 0.0);

@@ -56,6 +56,8 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
   particles_.has_affine = scheme_->affine();
+  particles_.has_temperature = config_.thermal.conduction;
+  for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
@@ -308,7 +310,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
         }
       }
       if (forces) {
-        nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * G);
+        nodes_.force[i] -= P.volume0[p] * P.kirchhoff_stress[p].template times<D>(G);
         if (has_body_force) {
           const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
           nodes_.force[i] += fb;
@@ -577,9 +579,10 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, dou
                       : nullptr;
   MaterialPoint point{F, L, state, dt};
   point.dF = &dF;
-  point.tau_old = &particles_.kirchhoff_stress[p];
+  const Mat3 tau_old = particles_.kirchhoff_stress[p];
+  point.tau_old = &tau_old;
   point.cell_size = grid_.min_cell_size();
-  point.temperature = &particles_.temperature[p];
+  point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
   const Material& m = *materials_[particles_.material[p]];
   if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
   return m.update(point);
@@ -668,8 +671,9 @@ Totals Simulation<D>::totals() const {
     return Vec3(to3<D>(P.mass[p] * P.velocity[p]));
   });
   t.mass = chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p]; });
-  t.mean_temperature =
-      chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
+  if (P.has_temperature)
+    t.mean_temperature =
+        chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
   double p_max = -std::numeric_limits<double>::infinity();
 #pragma omp parallel for reduction(max : p_max)
   for (std::int64_t p = 0; p < n; ++p)
