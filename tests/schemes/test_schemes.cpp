@@ -9,6 +9,7 @@
 #include "../support/config_builder.hpp"
 #include "cairn/sim/names.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
 namespace {
@@ -40,11 +41,11 @@ TEST(FullMass, ExpansionConvergesToTheFullMassSolve) {
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(na, na);
   Eigen::MatrixXd p = Eigen::MatrixXd::Zero(na, 2);
   for (std::size_t q = 0; q < P.n(); ++q) {
-    const std::size_t b = q * c.stride;
-    for (std::size_t s = b; s < b + c.count[q]; ++s) {
-      const int i = index[c.node[s]];
-      p.row(i) += c.weight[s] * P.mass[q] * P.velocity[q].transpose();
-      for (std::size_t t = b; t < b + c.count[q]; ++t) M(i, index[c.node[t]]) += P.mass[q] * c.weight[s] * c.weight[t];
+    const auto entries = stencil_entries(c, q);
+    for (const auto& es : entries) {
+      const int i = index[es.node];
+      p.row(i) += es.weight * P.mass[q] * P.velocity[q].transpose();
+      for (const auto& et : entries) M(i, index[et.node]) += P.mass[q] * es.weight * et.weight;
     }
   }
   const Eigen::MatrixXd exact = M.ldlt().solve(p);
@@ -127,10 +128,10 @@ double angular_momentum(const Particles<2>& P, const TransferCache<2>& c, const 
   for (std::size_t p = 0; p < P.n(); ++p) {
     L += P.mass[p] * (P.position[p][0] * P.velocity[p][1] - P.position[p][1] * P.velocity[p][0]);
     const Eigen::Matrix2d C = P.affine_velocity[p].topLeftCorner<2, 2>();
-    for (std::size_t s = p * c.stride; s < p * c.stride + c.count[p]; ++s) {
-      const Vec<2> d = g.node_position(c.node[s]) - P.position[p];
+    for (const auto& e : stencil_entries(c, p)) {
+      const Vec<2> d = g.node_position(e.node) - P.position[p];
       const Vec<2> u = C * d;
-      L += P.mass[p] * c.weight[s] * (d[0] * u[1] - d[1] * u[0]);
+      L += P.mass[p] * e.weight * (d[0] * u[1] - d[1] * u[0]);
     }
   }
   return L;

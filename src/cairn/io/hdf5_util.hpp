@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,11 @@ void write_doubles(hid_t loc, const std::string& name, const double* data, std::
 /// Write a double dataset of any rank with the given shape (row-major, last index fastest).
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
                           const std::vector<std::size_t>& shape);
+/// Write a rows x cols double dataset block by block: fill(first, count, buffer) stores rows
+/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB, so an array
+/// whose memory layout differs from the file's is written without a copy of the whole array.
+void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill);
 /// Write a 1D int32 dataset of length `n`.
 void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n);
 /// Write a text (any length, no embedded NUL) as a scalar fixed-length string dataset.

@@ -54,6 +54,8 @@ class Material {
   virtual void initialize_state(double* state) const { (void)state; }
   /// Initial particle temperature (0 for models without a thermal part).
   [[nodiscard]] virtual double initial_temperature() const { return 0.0; }
+  /// Whether the model reads or updates the particle temperature (MaterialPoint::temperature).
+  [[nodiscard]] virtual bool uses_temperature() const { return false; }
   /// Speed of the fastest wave at deformation F, used by the CFL time step.
   [[nodiscard]] virtual double wave_speed(const Mat3& F) const = 0;
 

@@ -72,6 +72,7 @@ class MieGruneisen final : public Material {
     store_be(s, Mat3::Identity());
   }
   double initial_temperature() const override { return T0_; }
+  bool uses_temperature() const override { return true; }
 
   /// Pressure from the EOS (Eq. 51, compression branch for eta > 0).
   double pressure(double J, double U) const {

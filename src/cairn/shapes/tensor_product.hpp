@@ -37,10 +37,14 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
                                 " nodes wide per axis exceeds the limit of " +
                                 std::to_string(max_width) +
                                 " (smoothing length or particle size too large for the cell size)");
+  // Widths 2-4 (every family at ordinary particle sizes) keep the per-axis factors (tensor
+  // layout); wider GIMP stencils are expanded into the list layout.
+  const bool factored = width >= 2 && width <= 4;
   int slots = 1;
   for (int a = 0; a < D; ++a) slots *= width;
   const auto n = particles.n();
-  cache.reserve(n, slots);
+  if (factored) cache.reserve_tensor(n, width);
+  else cache.reserve(n, slots);
   const Vec<D> inv_h = grid.cell_size().cwiseInverse();
 
   std::int64_t first_bad = INT64_MAX;
@@ -65,7 +69,6 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
         cell[a] = static_cast<int>(std::floor(xi[a]));
         first[a] = kernel.eval(particles, p, a, xi[a], w[a].data(), dw[a].data());
       }
-      cache.cell[p] = cell;
       // Per-axis storage offsets of the stencil nodes (-1: beyond the ghost layers).
       std::array<std::array<std::int32_t, max_width>, D> offset{};
       for (int a = 0; a < D; ++a)
@@ -73,10 +76,34 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
           int j = first[a] + k;
           if constexpr (requires { kernel.node_of(a, first[a], k); }) j = kernel.node_of(a, first[a], k);
           offset[a][k] = grid.axis_index(a, j);
-          if (w[a][k] == 0.0 && dw[a][k] == 0.0) continue;  // outside the support: no reach
+          // The tensor layout visits every entry, so its reach is the full width.
+          if (!factored && w[a][k] == 0.0 && dw[a][k] == 0.0) continue;  // outside the support
           lo_t[a] = std::max(lo_t[a], cell[a] - j);
           hi_t[a] = std::max(hi_t[a], j - cell[a] - 1);
         }
+      if (factored) {
+        // A node beyond the ghost layers is an error where the particle has weight there; where
+        // it has none (phi = dphi = 0) the entry is kept with a stored neighbour's offset, so the
+        // transfers add zeros to a node of the stencil.
+        std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * width];
+        double* value_out = &cache.axis_value[static_cast<std::size_t>(p) * D * 2 * width];
+        for (int a = 0; a < D; ++a) {
+          std::int32_t stored = -1;
+          for (int k = 0; k < width; ++k)
+            if (offset[a][k] >= 0) stored = offset[a][k];
+          for (int k = 0; k < width; ++k) {
+            std::int32_t off = offset[a][k];
+            if (off < 0) {
+              if (w[a][k] != 0.0 || dw[a][k] != 0.0 || stored < 0) bad_t = std::min<std::int64_t>(bad_t, p);
+              off = std::max(stored, 0);
+            }
+            node_out[a * width + k] = off;
+            value_out[a * 2 * width + k] = w[a][k];
+            value_out[a * 2 * width + width + k] = dw[a][k] * inv_h[a];
+          }
+        }
+        continue;
+      }
       const std::size_t base = static_cast<std::size_t>(p) * slots;
       int used = 0;
       std::array<int, D> k{};  // odometer over the width^D box, axis 0 fastest

@@ -239,9 +239,8 @@ class Runner {
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
-    data.particles = sim_.particles();
     last_checkpoint_ = dir_ / fmt::format("checkpoint-{:04d}.h5", checkpoint_index_++);
-    write_checkpoint<D>(last_checkpoint_, data);
+    write_checkpoint<D>(last_checkpoint_, data, sim_.particles());  // no copy of the particles
   }
 
   /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.

@@ -57,7 +57,11 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
   check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
+  particles_.has_affine = scheme_->affine();
+  particles_.has_temperature = config_.thermal.conduction;
+  for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
+  particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
   if (config_.thermal.conduction) {
     std::vector<double> k, cp;
@@ -81,14 +85,18 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     field_offset_.resize(particles_.n());
     for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
   }
-  nodes_.resize(n_slots());
-  grid_term_.assign(n_slots(), Vec<D>::Zero());
-  grid_proj_.assign(n_slots(), Vec<D>::Zero());
-  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
-  particle_scalar_.assign(particles_.n(), 0.0);
-  body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
+  // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
+  // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
+  const bool node_scratch = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
+  nodes_.resize(n_slots(), node_scratch);
+  if (node_scratch) {
+    grid_term_.assign(n_slots(), Vec<D>::Zero());
+    grid_proj_.assign(n_slots(), Vec<D>::Zero());
+  }
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
+  if (conditions_.empty() && velocity_conditions_.empty())
+    std::vector<Vec<D>>().swap(nodes_.reaction);  // nothing records reactions
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
   if (!config_.body_force.expression.empty()) {
@@ -180,6 +188,10 @@ void Simulation<D>::step(double dt) {
       next_full_mass_time_ = time_ + config_.method.full_mass_cfl * grid_.min_cell_size() / max_signal_speed();
   }
   const bool fmpm_velocities = use_full_mass_ && need == FullMass::of_updated;
+  if (scheme_->affine() && particles_.affine_velocity.size() != particles_.n()) {
+    particles_.has_affine = true;  // e.g. restarted with APIC from a checkpoint without C_p
+    particles_.affine_velocity.assign(particles_.n(), Mat3::Zero());
+  }
   const int k = config_.method.order;
   step_dt_ = dt;
 
@@ -240,18 +252,15 @@ void Simulation<D>::step(double dt) {
 template <int D>
 void Simulation<D>::build_stencils() {
   shape_->build(grid_, particles_, cache_);
-  colour_blocks(grid_, cache_);
-  if (contact_) contact_->fill_slots(particles_, cache_);
+  colour_blocks(grid_, particles_, cache_);
 }
 
 template <int D>
 void Simulation<D>::compute_body_forces() {
   if (body_force_.empty()) return;
   const auto n = static_cast<std::int64_t>(particles_.n());
-  if (body_force_constant_) {
-    std::fill(body_acceleration_.begin(), body_acceleration_.end(), body_force_value_);
-    return;
-  }
+  if (body_force_constant_) return;  // particles_to_grid reads body_force_value_
+  body_acceleration_.resize(particles_.n());
 #pragma omp parallel
   {
     auto& expr = *body_force_[omp_get_thread_num()];
@@ -279,7 +288,6 @@ template <int D>
 void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   const bool has_body_force = !body_force_.empty();
   const bool affine = scheme_->affine();
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) {
     if (mass_and_momentum) {
       nodes_.mass[i] = 0.0;
@@ -289,31 +297,34 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       nodes_.force[i].setZero();
       if (has_body_force) node_body_force_[i].setZero();
     }
-    nodes_.reaction[i].setZero();
+    if (!nodes_.reaction.empty()) nodes_.reaction[i].setZero();
   });
   if (forces) compute_body_forces();
   const auto& P = particles_;
   // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    const std::int32_t i = idx[s];
-    const double Sm = cache_.weight[s] * P.mass[p];
-    if (mass_and_momentum) {
-      nodes_.mass[i] += Sm;
-      if (affine) {
-        const Vec<D> dx = node_offset(grid_, cache_.node[s], P.position[p]);
-        nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
-      } else {
-        nodes_.momentum[i] += Sm * P.velocity[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+      const std::int32_t i = node + off;
+      const double Sm = S * P.mass[p];
+      if (mass_and_momentum) {
+        nodes_.mass[i] += Sm;
+        if (affine) {
+          const Vec<D> dx = node_offset(grid_, node, P.position[p]);
+          nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+        } else {
+          nodes_.momentum[i] += Sm * P.velocity[p];
+        }
       }
-    }
-    if (forces) {
-      nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * cache_.gradient[s]);
-      if (has_body_force) {
-        const Vec<D> fb = Sm * body_acceleration_[p];
-        nodes_.force[i] += fb;
-        node_body_force_[i] += fb;
+      if (forces) {
+        nodes_.force[i] -= P.volume0[p] * P.kirchhoff_stress[p].template times<D>(G);
+        if (has_body_force) {
+          const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
+          nodes_.force[i] += fb;
+          node_body_force_[i] += fb;
+        }
       }
-    }
+    });
   });
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
@@ -378,7 +389,7 @@ void Simulation<D>::update_grid(double dt) {
   if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
     external_work_ += dt * chunked_sum<double>(n_slots(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
-      double w = nodes_.reaction[i].dot(v_mean);
+      double w = nodes_.reaction.empty() ? 0.0 : nodes_.reaction[i].dot(v_mean);
       if (has_body_force) w += node_body_force_[i].dot(v_mean);
       return w;
     });
@@ -388,15 +399,19 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  particle_vec_.resize(particles_.n());
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     Vec<D> u = Vec<D>::Zero();
-    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[idx[s]];
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { u += S * in[node + off]; });
     particle_vec_[p] = u;
   });
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    out[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      out[node + off] += (S * particles_.mass[p]) * particle_vec_[p];
+    });
   });
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
@@ -502,10 +517,12 @@ void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& mom
 
 template <int D>
 void Simulation<D>::reextrapolate_momentum() {
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) { grid_term_[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    grid_term_[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      grid_term_[node + off] += (S * particles_.mass[p]) * particles_.velocity[p];
+    });
   });
   if (contact_)  // the re-extrapolated momenta obey contact too (same normals and separations)
     contact_->correct(nodes_.mass, grid_term_, true, Contact<D>::Pass::stress, time_, step_dt_, nullptr);
@@ -524,23 +541,23 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  // The sum is the energy dissipated relative to the non-dissipative FLIP update (seed 002
+  // Eq. 1.50).
+  dissipated_energy_ += gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::int32_t i = idx[s];
-      const double S = cache_.weight[s];
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      const std::int32_t i = node + off;
       g.Sv += S * v[i];
       g.Sv_new += S * v_new[i];
       if (full) g.Sv_full += S * v_full[i];
-    }
+    });
     if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
     const Vec<D> x_old = P.position[p];
     P.velocity[p] += e.A_dt;
     P.position[p] += dX;
@@ -549,17 +566,16 @@ void Simulation<D>::update_particles(double dt) {
       // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
       // for every shape family (D = h^2/4 I for quadratic splines).
       Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
-      for (std::size_t s = begin; s < end; ++s) {
-        const Vec<D> d = node_offset(grid_, cache_.node[s], x_old);
-        B += cache_.weight[s] * v_new[idx[s]] * d.transpose();
-        Dp += cache_.weight[s] * d * d.transpose();
-      }
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+        const Vec<D> d = node_offset(grid_, node, x_old);
+        B += S * v_new[node + off] * d.transpose();
+        Dp += S * d * d.transpose();
+      });
       P.affine_velocity[p].setZero();
       P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
     }
+    return dissipated;
   });
-  dissipated_energy_ += chunked_sum<double>(static_cast<std::int64_t>(P.n()), 0.0,
-                                            [&](std::int64_t p) { return particle_scalar_[p]; });
 }
 
 template <int D>
@@ -570,9 +586,10 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, dou
                       : nullptr;
   MaterialPoint point{F, L, state, dt};
   point.dF = &dF;
-  point.tau_old = &particles_.kirchhoff_stress[p];
+  const Mat3 tau_old = particles_.kirchhoff_stress[p];
+  point.tau_old = &tau_old;
   point.cell_size = grid_.min_cell_size();
-  point.temperature = &particles_.temperature[p];
+  point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
   const Material& m = *materials_[particles_.material[p]];
   if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
   return m.update(point);
@@ -583,12 +600,12 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
     Mat3 L = Mat3::Zero();
-    for (std::size_t s = begin; s < end; ++s)
-      L.template topLeftCorner<D, D>() += grid_velocity[idx[s]] * cache_.gradient[s].transpose();
-    particles_.velocity_gradient[p] = L;
+    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
+      L.template topLeftCorner<D, D>() += grid_velocity[node + off] * G.transpose();
+    });
     Mat3& F = particles_.deformation_gradient[p];
     const Mat3 dF = tensor_exp(L * dt);
     F = dF * F;
@@ -632,7 +649,7 @@ NodeField<D> Simulation<D>::grid_totals() const {
       t.force[i] += nodes_.force[s];
       t.velocity_new[i] += nodes_.mass[s] * nodes_.velocity_new[s];
       t.velocity[i] += nodes_.mass[s] * nodes_.velocity[s];
-      t.reaction[i] += nodes_.reaction[s];
+      if (!nodes_.reaction.empty()) t.reaction[i] += nodes_.reaction[s];
     }
     if (t.mass[i] > small_mass_) {
       t.velocity_new[i] /= t.mass[i];
@@ -661,8 +678,9 @@ Totals Simulation<D>::totals() const {
     return Vec3(to3<D>(P.mass[p] * P.velocity[p]));
   });
   t.mass = chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p]; });
-  t.mean_temperature =
-      chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
+  if (P.has_temperature)
+    t.mean_temperature =
+        chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
   double p_max = -std::numeric_limits<double>::infinity();
 #pragma omp parallel for reduction(max : p_max)
   for (std::int64_t p = 0; p < n; ++p)

@@ -1,5 +1,11 @@
 // Generic particle<->grid kernels over the transfer cache, written once for every shape family.
 //
+// A kernel's callback gets a particle index and that particle's stencil, whose for_each(fn)
+// calls fn(node, S, G) for every entry: node is the storage index (add the particle's field
+// offset in multimaterial mode), S = S_pi and G = G_pi. The stencil type depends on the cache
+// layout (transfer/cache.hpp), so callbacks are generic lambdas ([&](auto p, const auto& st));
+// each kernel picks the layout once per call and the entry loop is compiled for it.
+//
 // Parallel strategy and the guarantee it gives: particles are binned into blocks of cells wide
 // enough that two blocks of the same colour never touch a common node. Scatters run colour by
 // colour; within a colour, blocks run in parallel and each block adds its particles in storage
@@ -7,45 +13,178 @@
 // the number of threads, so results are bit-identical for any OMP_NUM_THREADS.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 
 namespace cairn {
 
-/// Bin particles into coloured cell blocks using cache.cell and the reach reported by the shape
-/// family. Call after every stencil build. Allocation-free once sized.
+/// Bin particles into coloured cell blocks by the cell holding each particle (grid.cell_of) and
+/// the reach reported by the shape family. Call after every stencil build. Allocation-free once
+/// sized.
 template <int D>
-void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache);
+void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferCache<D>& cache);
 
-/// Scatter: calls fn(p, slot) for every particle p and stencil slot, race-free as above; fn may
-/// add into node arrays indexed by cache.node[slot].
-template <int D, class Fn>
-void scatter(const TransferCache<D>& cache, Fn&& fn) {
-  for (const auto& blocks : cache.colour_blocks) {
-    const auto n_blocks = static_cast<std::int64_t>(blocks.size());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t b = 0; b < n_blocks; ++b) {
-      const std::int32_t block = blocks[b];
-      for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
-        const std::int32_t p = cache.order[i];
-        const std::size_t base = static_cast<std::size_t>(p) * cache.stride;
-        for (std::size_t s = base; s < base + cache.count[p]; ++s) fn(p, s);
+/// One particle's stencil in the list layout.
+template <int D>
+struct ListStencil {
+  const std::int32_t* node;
+  const double* weight;
+  const Vec<D>* gradient;
+  int count;
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    for (int s = 0; s < count; ++s) fn(node[s], weight[s], gradient[s]);
+  }
+};
+
+/// One particle's stencil in the tensor layout with W nodes per axis: entry (k_0, ..., k_D-1),
+/// axis 0 fastest, has node sum_a offset_a(k_a), S = prod_a phi_a(k_a) and
+/// G_b = prod_a (a == b ? dphi_a : phi_a)(k_a) (seed 003 Eq. 18), the products taken in axis order.
+template <int D, int W>
+struct TensorStencil {
+  const std::int32_t* node;  ///< D x W offsets
+  const double* value;       ///< D x 2W: phi then dphi per axis
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    const double* w0 = value;
+    const double* d0 = value + W;
+    if constexpr (D == 1) {
+      for (int i = 0; i < W; ++i) fn(node[i], w0[i], Vec<1>(d0[i]));
+    } else {
+      const double* w1 = value + 2 * W;
+      const double* d1 = value + 3 * W;
+      if constexpr (D == 2) {
+        for (int j = 0; j < W; ++j)
+          for (int i = 0; i < W; ++i) fn(node[i] + node[W + j], w0[i] * w1[j], Vec<2>(d0[i] * w1[j], w0[i] * d1[j]));
+      } else {
+        const double* w2 = value + 4 * W;
+        const double* d2 = value + 5 * W;
+        for (int k = 0; k < W; ++k)
+          for (int j = 0; j < W; ++j) {
+            const std::int32_t row = node[W + j] + node[2 * W + k];
+            for (int i = 0; i < W; ++i) {
+              const double w01 = w0[i] * w1[j];
+              fn(row + node[i], w01 * w2[k],
+                 Vec<3>((d0[i] * w1[j]) * w2[k], (w0[i] * d1[j]) * w2[k], w01 * d2[k]));
+            }
+          }
       }
     }
   }
+};
+
+/// Calls fn(stencil_of) with a callable that returns particle p's stencil, typed for the cache's
+/// layout (and width), so that everything fn does per particle is compiled for that layout.
+template <int D, class Fn>
+void with_stencils(const TransferCache<D>& cache, Fn&& fn) {
+  if (cache.layout == StencilLayout::list) {
+    fn([&cache](std::size_t p) {
+      const std::size_t b = p * static_cast<std::size_t>(cache.stride);
+      return ListStencil<D>{&cache.node[b], &cache.weight[b], &cache.gradient[b], cache.count[p]};
+    });
+    return;
+  }
+  auto tensor = [&]<int W>() {
+    fn([&cache](std::size_t p) {
+      return TensorStencil<D, W>{&cache.axis_node[p * D * W], &cache.axis_value[p * D * 2 * W]};
+    });
+  };
+  switch (cache.width) {
+    case 2: tensor.template operator()<2>(); break;
+    case 3: tensor.template operator()<3>(); break;
+    default: tensor.template operator()<4>(); break;
+  }
 }
 
-/// Gather: calls fn(p, begin, end) for every particle in parallel with its slot range.
+/// fn(node, S, G) for every stencil entry of particle p (one layout test per call: for code
+/// outside the hot loops).
+template <int D, class Fn>
+void for_each_entry(const TransferCache<D>& cache, std::size_t p, Fn&& fn) {
+  with_stencils(cache, [&](auto stencil_of) { stencil_of(p).for_each(fn); });
+}
+
+/// One stencil entry, for code that wants the entries as data (tests, diagnostics).
+template <int D>
+struct StencilEntry {
+  std::int32_t node;
+  double weight;
+  Vec<D> gradient;
+};
+
+/// Particle p's entries with S != 0 or G != 0, in stencil order.
+template <int D>
+std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std::size_t p) {
+  std::vector<StencilEntry<D>> out;
+  for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>& G) {
+    if (S != 0.0 || !G.isZero(0.0)) out.push_back({node, S, G});
+  });
+  return out;
+}
+
+/// Scatter: calls fn(p, stencil) for every particle p, race-free as above; fn may add into node
+/// arrays at the stencil's nodes.
+template <int D, class Fn>
+void scatter(const TransferCache<D>& cache, Fn&& fn) {
+  with_stencils(cache, [&](auto stencil_of) {
+    for (const auto& blocks : cache.colour_blocks) {
+      const auto n_blocks = static_cast<std::int64_t>(blocks.size());
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::int64_t b = 0; b < n_blocks; ++b) {
+        const std::int32_t block = blocks[b];
+        for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
+          const std::int32_t p = cache.order[i];
+          fn(p, stencil_of(static_cast<std::size_t>(p)));
+        }
+      }
+    }
+  });
+}
+
+/// Particles per work chunk of a gather. Fixed, so that sums taken chunk by chunk do not depend
+/// on the thread count; small, so that threads share the work evenly when one of them is slowed
+/// down by another process on its core (chunks are handed out dynamically).
+inline constexpr std::int64_t gather_chunk = 512;
+
+/// Gather: calls fn(p, stencil) for every particle, in parallel over chunks of particles.
 template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
-  const auto n = static_cast<std::int64_t>(cache.count.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const std::size_t base = static_cast<std::size_t>(p) * cache.stride;
-    fn(p, base, base + cache.count[p]);
-  }
+  with_stencils(cache, [&](auto stencil_of) {
+    const auto n = static_cast<std::int64_t>(cache.n);
+    const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
+    }
+  });
+}
+
+/// Gather that also returns sum_p fn(p, stencil): a running sum within each chunk, the chunks'
+/// sums added in chunk order, so the total is the same for any thread count.
+template <int D, class Fn>
+double gather_sum(const TransferCache<D>& cache, Fn&& fn) {
+  const auto n = static_cast<std::int64_t>(cache.n);
+  const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+  std::vector<double> partial(static_cast<std::size_t>(n_chunks), 0.0);
+  with_stencils(cache, [&](auto stencil_of) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      double sum = 0.0;
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) sum += fn(p, stencil_of(static_cast<std::size_t>(p)));
+      partial[static_cast<std::size_t>(c)] = sum;
+    }
+  });
+  double total = 0.0;
+  for (double s : partial) total += s;
+  return total;
 }
 
 /// Parallel loop over nodes.
