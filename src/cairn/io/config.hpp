@@ -35,6 +35,7 @@ struct SimulationConfig {
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
+  double rebalance_threshold = 0.25;  ///< MPI: repartition when max/mean particles - 1 exceeds it
   double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
   std::string body_overlap = "error";  ///< bodies sharing space: error | warn
   SourceLocation where;     ///< the [simulation] table (end_time's line when given)

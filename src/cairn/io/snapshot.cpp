@@ -67,8 +67,8 @@ const char* xdmf_header() {
 }  // namespace
 
 template <int D>
-SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem)
-    : directory_(std::move(directory)), stem_(std::move(stem)) {
+SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem, const Comm& comm)
+    : directory_(std::move(directory)), stem_(std::move(stem)), comm_(comm) {
   if (stem_.empty()) throw std::invalid_argument("snapshot file stem must not be empty");
 }
 
@@ -146,41 +146,68 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
                              3.0 * (syz * syz + sxz * sxz + sxy * sxy));
   }
 
-  // Grid node data, stored array order (x fastest) and shape slowest axis first.
+  // Particles rank after rank (one rank: all of them, in order).
+  const h5::Rows rows = h5::rows_of(comm_, n);
+
+  // Grid node data, stored array order (x fastest) and shape slowest axis first, over the whole
+  // grid; each rank contributes the box of nodes it owns (all stored nodes on one rank).
   FileInfo file_info;
   file_info.readable = true;
-  file_info.n_particles = n;
+  file_info.n_particles = rows.total;
   std::vector<double> node_mass, node_velocity, node_normal;
+  std::vector<std::size_t> box_start, box_count, vbox_start, vbox_count;
   if (with_grid) {
+    const Grid<D> whole = grid->whole();
     file_info.has_grid = true;
     file_info.origin.assign(3, 0.0);
     file_info.spacing.assign(3, 1.0);
-    const Vec<D> first = grid->node_position(0);
+    const Vec<D> first = whole.node_position(0);
     for (int a = 0; a < D; ++a) {
       file_info.origin[a] = first[a];
       file_info.spacing[a] = grid->cell_size()[a];
     }
-    if (D == 1) file_info.node_shape.push_back(1);
+    if (D == 1) {
+      file_info.node_shape.push_back(1);
+      box_start.push_back(0);
+      box_count.push_back(1);
+    }
+    IVec<D> lo, hi;  // owned nodes, domain numbering, [lo, hi)
+    for (int a = 0; a < D; ++a) {
+      const int f = whole.first_node(a), stored = whole.stored_nodes(a);
+      lo[a] = grid->own_lo()[a] == 0 && !grid->periodic(a) ? f : grid->own_lo()[a];
+      hi[a] = grid->own_hi()[a] == grid->n_cells()[a] && !grid->periodic(a) ? f + stored : grid->own_hi()[a];
+    }
     for (int a = D - 1; a >= 0; --a) {
-      file_info.node_shape.push_back(static_cast<std::size_t>(grid->stored_nodes(a)));
+      file_info.node_shape.push_back(static_cast<std::size_t>(whole.stored_nodes(a)));
+      box_start.push_back(static_cast<std::size_t>(lo[a] - whole.first_node(a)));
+      box_count.push_back(static_cast<std::size_t>(hi[a] - lo[a]));
     }
-    const auto nn = static_cast<std::size_t>(grid->n_nodes());
-    node_mass = nodes->mass;
-    node_velocity.assign(3 * nn, 0.0);
-    for (std::size_t i = 0; i < nn; ++i) {
-      for (int a = 0; a < D; ++a) node_velocity[3 * i + a] = nodes->velocity_new[i][a];
-    }
-    if (contact_normals && contact_normals->size() == nn) {
-      file_info.has_contact_normal = true;
-      node_normal.assign(3 * nn, 0.0);
-      for (std::size_t i = 0; i < nn; ++i)
-        for (int a = 0; a < 3; ++a) node_normal[3 * i + a] = (*contact_normals)[i][a];
+    vbox_start = box_start;
+    vbox_start.push_back(0);
+    vbox_count = box_count;
+    vbox_count.push_back(3);
+    const bool normals = contact_normals && contact_normals->size() == static_cast<std::size_t>(grid->n_nodes());
+    file_info.has_contact_normal = comm_.any(normals);
+    // The owned box in file order (x fastest).
+    IVec<D> j = lo;
+    std::size_t box_nodes = 1;
+    for (int a = 0; a < D; ++a) box_nodes *= static_cast<std::size_t>(hi[a] - lo[a]);
+    for (std::size_t k = 0; k < box_nodes; ++k) {
+      const std::int32_t i = grid->node_index(j);
+      node_mass.push_back(nodes->mass[i]);
+      for (int a = 0; a < 3; ++a) node_velocity.push_back(a < D ? nodes->velocity_new[i][a] : 0.0);
+      if (file_info.has_contact_normal)
+        for (int a = 0; a < 3; ++a) node_normal.push_back(normals ? (*contact_normals)[i][a] : 0.0);
+      for (int a = 0; a < D; ++a) {
+        if (++j[a] < hi[a]) break;
+        j[a] = lo[a];
+      }
     }
   }
 
   const fs::path target = snapshot_path(next_index_);
-  write_file_atomically(target, [&](const fs::path& tmp) {
-    h5::Handle file = h5::create_file(tmp);
+  write_file_atomically(target, comm_, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp, comm_);
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", "cairn-snapshot");
     h5::write_double_attribute(root, "time", time);
@@ -189,29 +216,31 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
     {
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
-      h5::write_doubles(gid, "position", position.data(), n, 3);
-      h5::write_doubles(gid, "velocity", velocity.data(), n, 3);
-      h5::write_doubles(gid, "displacement", displacement.data(), n, 3);
-      h5::write_doubles(gid, "mass", particles.mass.data(), n);
-      h5::write_doubles(gid, "volume", volume.data(), n);
-      h5::write_doubles(gid, "stress", stress.data(), n, 6);
-      h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9);
-      h5::write_doubles(gid, "pressure", pressure.data(), n);
-      h5::write_doubles(gid, "von_mises", von_mises.data(), n);
+      h5::write_doubles_rows(gid, "position", position.data(), rows, 3);
+      h5::write_doubles_rows(gid, "velocity", velocity.data(), rows, 3);
+      h5::write_doubles_rows(gid, "displacement", displacement.data(), rows, 3);
+      h5::write_doubles_rows(gid, "mass", particles.mass.data(), rows);
+      h5::write_doubles_rows(gid, "volume", volume.data(), rows);
+      h5::write_doubles_rows(gid, "stress", stress.data(), rows, 6);
+      h5::write_doubles_rows(gid, "deformation_gradient", deformation.data(), rows, 9);
+      h5::write_doubles_rows(gid, "pressure", pressure.data(), rows);
+      h5::write_doubles_rows(gid, "von_mises", von_mises.data(), rows);
       std::vector<double> zero;  // runs without a thermal model store no temperatures
       if (particles.temperature.size() != n) zero.assign(n, 0.0);
-      h5::write_doubles(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), n);
-      h5::write_ints(gid, "material", particles.material.data(), n);
-      h5::write_ints(gid, "body", particles.body.data(), n);
+      h5::write_doubles_rows(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), rows);
+      h5::write_ints_rows(gid, "material", particles.material.data(), rows);
+      h5::write_ints_rows(gid, "body", particles.body.data(), rows);
+      if (particles.id.size() == n) h5::write_int64s_rows(gid, "id", particles.id.data(), rows);
     }
     if (with_grid) {
       h5::Handle g = h5::create_group(root, "grid");
       const hid_t gid = g.get();
-      h5::write_doubles_shaped(gid, "node_mass", node_mass.data(), file_info.node_shape);
+      h5::write_doubles_box(gid, "node_mass", node_mass.data(), file_info.node_shape, box_start, box_count);
       std::vector<std::size_t> vshape = file_info.node_shape;
       vshape.push_back(3);
-      h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape);
-      if (file_info.has_contact_normal) h5::write_doubles_shaped(gid, "contact_normal", node_normal.data(), vshape);
+      h5::write_doubles_box(gid, "node_velocity", node_velocity.data(), vshape, vbox_start, vbox_count);
+      if (file_info.has_contact_normal)
+        h5::write_doubles_box(gid, "contact_normal", node_normal.data(), vshape, vbox_start, vbox_count);
       h5::write_doubles_attribute(gid, "origin", file_info.origin);
       h5::write_doubles_attribute(gid, "spacing", file_info.spacing);
     }
@@ -228,7 +257,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   }
   if (!replaced) entries_.emplace_back(time, name);
   ++next_index_;
-  write_xdmf();
+  if (comm_.is_root()) write_xdmf();
 }
 
 template <int D>

@@ -14,6 +14,8 @@
 //   /particles/stress                Cauchy sigma = tau / det F, n x 6, Voigt order xx,yy,zz,yz,xz,xy
 //   /particles/deformation_gradient  n x 9, row-major (F00, F01, F02, F10, ...)
 //   /particles/material, body        int32, n
+//   /particles/id                    int64, n: the particle's number (creation order); a run on
+//                                    several MPI ranks stores its particles rank after rank
 //   /grid (optional): node_mass (shape [nz,] [ny,] nx; in 1D 1 x nx) and node_velocity (same
 //     shape x 3), over all stored nodes including ghost layers, x fastest; attributes origin and
 //     spacing (position of stored node 0 and the cell size, x y z, padded with 0 and 1).
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {
@@ -41,7 +44,11 @@ class SnapshotWriter {
 
   /// Snapshots go to `directory`/snapshots, index files to `directory`. Nothing is written
   /// until the first write().
-  explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles");
+  /// A `comm` of several ranks writes collectively (parallel HDF5): each rank passes its own
+  /// particles (they are stored rank after rank, each with its id) and its grid window (each
+  /// rank writes the nodes it owns); rank 0 writes the XDMF files (docs/parallel.md).
+  explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles",
+                          const Comm& comm = Comm::serial());
 
   /// Write snapshot number next_index() of `particles` at `time`/`step` and rewrite the XDMF
   /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
@@ -87,6 +94,7 @@ class SnapshotWriter {
 
   std::filesystem::path directory_;
   std::string stem_;
+  Comm comm_;
   int next_index_ = 0;
   std::vector<Entry> entries_;
   std::map<std::string, FileInfo> info_;

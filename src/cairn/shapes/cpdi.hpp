@@ -250,7 +250,6 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     for (std::int64_t p = 0; p < n; ++p) {
       if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
         bad_t = std::min<std::int64_t>(bad_t, p);
-        cache.cell[p] = IVec<D>::Zero();
         cache.count[p] = 0;
         continue;
       }

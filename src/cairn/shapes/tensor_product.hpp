@@ -60,8 +60,7 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
         bad_t = std::min<std::int64_t>(bad_t, p);
-        cache.cell[p] = IVec<D>::Zero();
-        cache.count[p] = 0;
+        if (!factored) cache.count[p] = 0;
         continue;
       }
       IVec<D> cell;

@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "cairn/io/checkpoint.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/snapshot.hpp"
@@ -34,6 +35,9 @@ const std::vector<std::string> history_columns = {
 template <int D>
 std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
   std::vector<std::string> columns = history_columns;
+  // Runs on several ranks: the particle imbalance (largest count of a rank / mean count) at
+  // the start of the last step; the other columns are those of a serial run, bit for bit.
+  if (sim.comm().parallel()) columns.push_back("imbalance");
   for (const auto& name : sim.velocity_conditions().names())
     for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
   for (const auto& wall : sim.velocity_conditions().walls())
@@ -66,15 +70,17 @@ class Runner {
   Runner(const Config& config, const RunOptions& options)
       : config_(config),
         options_(options),
-        sim_(config),
+        sim_(config, Comm::world()),
+        comm_(sim_.comm()),
         dir_(config.output.directory),
-        snapshots_(dir_) {
+        snapshots_(dir_, "particles", comm_) {
     const auto& out = config_.output;
     const double end = config_.simulation.end_time;
     snapshot_.interval = out.every;
     history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
     checkpoint_.interval = out.checkpoint_every;
-    std::filesystem::create_directories(dir_);
+    if (comm_.is_root()) std::filesystem::create_directories(dir_);
+    comm_.barrier();
   }
 
   /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
@@ -82,7 +88,7 @@ class Runner {
   ~Runner() {
     if (std::uncaught_exceptions() == 0) return;
     try {
-      history_writer_.flush();
+      flush_history();
     } catch (const std::exception&) {
       // the exception in flight says what went wrong
     }
@@ -91,8 +97,20 @@ class Runner {
   Runner& operator=(const Runner&) = delete;
 
   void restore(const CheckpointData<D>& data) {
-    check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
-    sim_.particles() = data.particles;
+    // Each rank checks its share of the rows; a bad row stops every rank with the same message.
+    std::string problem;
+    try {
+      check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
+    } catch (const InputError& e) {
+      if (!comm_.parallel()) throw;
+      problem = e.what();
+    }
+    const std::int64_t first_bad = comm_.min(problem.empty() ? std::int64_t{comm_.size()} : std::int64_t{comm_.rank()});
+    if (first_bad < comm_.size()) {
+      comm_.broadcast(problem, static_cast<int>(first_bad));
+      throw std::invalid_argument(problem);
+    }
+    sim_.set_particles(data.particles);
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
     auto& walls = sim_.velocity_conditions().walls();
@@ -114,8 +132,9 @@ class Runner {
     const auto start = Clock::now();
     const long long first_step = sim_.step_count();
     const auto& s = config_.simulation;
+    n_particles_ = sim_.total_particles();
     if (!restarted_) {
-      if (const std::string note = time_step_note(config_); !note.empty())
+      if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
         std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
       write_history_row();
@@ -130,7 +149,8 @@ class Runner {
         fail(f, dt);
       }
       last_dt_ = dt;
-      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
+      max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
+      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
       const double t = sim_.time();
       wrote_history = wrote_snapshot = false;
       if (history_.due(t)) {
@@ -151,7 +171,7 @@ class Runner {
     }
     if (!wrote_history) write_history_row();
     if (!wrote_snapshot) write_snapshot();
-    history_writer_.flush();
+    flush_history();
     if (config_.output.checkpoints) write_checkpoint_file();
     finish_progress();
 
@@ -159,7 +179,11 @@ class Runner {
     summary.steps = sim_.step_count() - first_step;
     summary.end_time = sim_.time();
     summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    summary.n_particles = sim_.particles().n();
+    summary.n_particles = static_cast<std::size_t>(n_particles_);
+    summary.ranks = comm_.size();
+    summary.partitions = sim_.distribution().partitions();
+    summary.migrated = comm_.sum(sim_.distribution().received());
+    summary.max_imbalance = max_imbalance_;
     summary.particle_steps_per_second =
         summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
     summary.output_directory = dir_;
@@ -196,17 +220,24 @@ class Runner {
       for (const auto& f : c->pair_forces())
         for (int a = 0; a < D; ++a) row.push_back(f[a]);
     }
+    if (comm_.parallel()) row.push_back(sim_.imbalance());
+    // Every rank keeps the rows (they are global sums, the same everywhere; checkpoints hold
+    // them), rank 0 alone writes the file.
     history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_, row);
     ++rows_since_flush_;
     if (rows_since_flush_ >= 20) {
-      history_writer_.flush();
+      flush_history();
       rows_since_flush_ = 0;
     }
   }
 
+  void flush_history() {
+    if (comm_.is_root()) history_writer_.flush();
+  }
+
   void write_snapshot() {
     if (!config_.output.snapshots) return;
-    history_writer_.flush();
+    flush_history();
     if (config_.output.grid_snapshots)
     {
       const NodeField<D> nodes = sim_.grid_totals();
@@ -240,15 +271,15 @@ class Runner {
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
     last_checkpoint_ = dir_ / fmt::format("checkpoint-{:04d}.h5", checkpoint_index_++);
-    write_checkpoint<D>(last_checkpoint_, data, sim_.particles());  // no copy of the particles
+    write_checkpoint<D>(last_checkpoint_, data, sim_.particles(), comm_);  // no copy of the particles
   }
 
   /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
   [[noreturn]] void fail(const SimulationFailure& f, double dt) {
-    history_writer_.flush();
+    flush_history();
     std::string saved;
     try {
-      SnapshotWriter<D> failure(dir_, "failure");
+      SnapshotWriter<D> failure(dir_, "failure", comm_);
       failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
@@ -261,7 +292,7 @@ class Runner {
   }
 
   void progress(Clock::time_point start, long long first_step) {
-    if (options_.quiet) return;
+    if (options_.quiet || !comm_.is_root()) return;
     const auto now = Clock::now();
     const double end = config_.simulation.end_time;
     const double frac = std::min(1.0, sim_.time() / end);
@@ -269,7 +300,7 @@ class Runner {
       if (now - last_progress_ < std::chrono::milliseconds(250)) return;
       last_progress_ = now;
       const double elapsed = std::chrono::duration<double>(now - start).count();
-      const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(sim_.particles().n()) / elapsed : 0.0;
+      const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(n_particles_) / elapsed : 0.0;
       const double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
       std::fprintf(stderr, "\r  step %lld  t = %.4g  %5.1f%%  ETA %6.1f s  %.3g particle-steps/s   ",
                    sim_.step_count(), sim_.time(), 100.0 * frac, eta, rate);
@@ -291,6 +322,9 @@ class Runner {
   Config config_;
   RunOptions options_;
   Simulation<D> sim_;
+  Comm comm_;
+  std::int64_t n_particles_ = 0;
+  double max_imbalance_ = 1.0;
   std::filesystem::path dir_;
   Schedule history_, snapshot_, checkpoint_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
@@ -346,7 +380,7 @@ namespace {
 template <int D>
 RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
                        const RunOptions& options) {
-  const CheckpointData<D> data = read_checkpoint<D>(file);
+  const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
