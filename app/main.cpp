@@ -41,11 +41,11 @@ void describe(const cairn::Config& config) {
 }
 
 void print_summary(const cairn::RunSummary& s) {
-  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} particle-steps/s with {} threads, "
-             "{} particles)\n",
-             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, omp_get_max_threads(),
-             s.n_particles);
-  fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {} threads, "
+             "{} {}s)\n",
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, omp_get_max_threads(),
+             s.n_particles, s.item);
+  fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;
   for (const auto& [name, sec] : s.stage_seconds) total += sec;

@@ -171,6 +171,8 @@ void write_checkpoint(const fs::path& path, const Checkpoint& d) {
     scalars["time"] = s.time;
     scalars["external_work"] = s.external_work;
     scalars["step"] = static_cast<double>(s.step);
+    scalars["displacement_error"] = s.error_now;
+    scalars["displacement_error_max"] = s.error_max;
     std::vector<std::string> names;
     std::vector<double> values;
     for (const auto& [k, v] : scalars) {
@@ -227,6 +229,8 @@ Checkpoint read_checkpoint(const fs::path& path) {
   s.time = d.scalars.at("time");
   s.external_work = d.scalars.at("external_work");
   s.step = static_cast<long long>(d.scalars.at("step"));
+  s.error_now = d.scalars.at("displacement_error");
+  s.error_max = d.scalars.at("displacement_error_max");
   const auto read = [&](const std::string& name) { return h5::read_doubles(root, name, h5::dataset_shape(root, name)); };
   s.x = unflat2(read("x"));
   s.v = unflat2(read("v"));

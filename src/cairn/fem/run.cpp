@@ -33,6 +33,7 @@ std::vector<std::string> columns(const Config& config) {
   std::vector<std::string> c = {"kinetic_energy", "strain_energy", "external_work", "total_energy",
                                 "energy_error",   "momentum_x",    "momentum_y",    "momentum_z",
                                 "max_pressure"};
+  if (!config.fem.exact_displacement.empty()) c.insert(c.end(), {"displacement_error", "displacement_error_max"});
   for (const auto& v : config.velocity_conditions)
     for (const char* axis : {"x", "y"}) c.push_back(fmt::format("reaction_{}_{}", v.name, axis));
   return c;
@@ -117,6 +118,8 @@ class Runner {
     summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     // For the FEM the "particles" of the summary are the elements (element-steps per second).
     summary.n_particles = solver_.mesh().n_elements();
+    summary.item = "element";
+    summary.xdmf = "fem.xdmf";
     summary.particle_steps_per_second =
         summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
     summary.output_directory = dir_;
@@ -131,6 +134,8 @@ class Runner {
     std::vector<double> row{t.kinetic_energy, t.strain_energy, solver_.external_work(), total,
                             total - initial_energy_ - solver_.external_work(), t.momentum[0], t.momentum[1],
                             t.momentum[2], t.max_pressure};
+    if (solver_.has_exact_displacement())
+      row.insert(row.end(), {solver_.displacement_error(), solver_.displacement_error_max()});
     for (const auto& r : solver_.reactions()) row.insert(row.end(), {r[0], r[1]});
     history_writer_.add_row(solver_.time(), solver_.step_count(), last_dt_, row);
     if (++rows_since_flush_ >= 20) {

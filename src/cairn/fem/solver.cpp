@@ -108,6 +108,7 @@ void Solver::setup() {
     auto u = field(cfg.fem.displacement, "fem.displacement");
     for (std::size_t i = 0; i < nn; ++i) x_[i] = mesh_.nodes[i] + (*u)(mesh_.nodes[i], mesh_.nodes[i], 0.0);
   }
+  if (!cfg.fem.exact_displacement.empty()) exact_ = field(cfg.fem.exact_displacement, "fem.exact_displacement");
   if (!cfg.body_force.expression.empty()) {
     try {
       body_force_ = std::make_unique<ExpressionVector<2>>(cfg.body_force.expression, constants);
@@ -169,6 +170,18 @@ void Solver::setup() {
   apply_conditions(v_, 0.0);
   update_stresses(0.0);
   compute_accelerations();
+  measure_error();
+}
+
+void Solver::measure_error() {
+  if (!exact_) return;
+  double err = 0.0;
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    const Vec<2>& X = mesh_.nodes[i];
+    err = std::max(err, (x_[i] - X - (*exact_)(x_[i], X, time_)).norm());  // seed 001 Eq. 38
+  }
+  error_now_ = err;
+  error_max_ = std::max(error_max_, err);
 }
 
 double Solver::condition_velocity(const NodeCondition& c, double t) const {
@@ -310,6 +323,7 @@ void Solver::step(double dt) {
   }
   apply_conditions(v_, time_);
   external_work_ += work;
+  measure_error();
 }
 
 double Solver::next_dt() const {
@@ -358,7 +372,7 @@ std::vector<Vec<2>> Solver::reactions() const {
 }
 
 Solver::State Solver::state() const {
-  return {time_, external_work_, step_, x_, v_, a_, b_, reaction_, F_, tau_, element_state_, temperature_};
+  return {time_, external_work_, error_now_, error_max_, step_, x_, v_, a_, b_, reaction_, F_, tau_, element_state_, temperature_};
 }
 
 void Solver::restore(const State& s) {
@@ -369,6 +383,8 @@ void Solver::restore(const State& s) {
     throw std::invalid_argument("FEM checkpoint does not match the mesh of the input");
   time_ = s.time;
   external_work_ = s.external_work;
+  error_now_ = s.error_now;
+  error_max_ = s.error_max;
   step_ = s.step;
   x_ = s.x;
   v_ = s.v;

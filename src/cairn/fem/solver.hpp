@@ -47,6 +47,11 @@ class Solver {
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] long long step_count() const { return step_; }
   [[nodiscard]] double external_work() const { return external_work_; }
+  /// With fem.exact_displacement: max over nodes of |x - X - u_exact(X, t)| now (seed 001
+  /// Eq. 38), and its maximum over every step so far; 0 without.
+  [[nodiscard]] double displacement_error() const { return error_now_; }
+  [[nodiscard]] double displacement_error_max() const { return error_max_; }
+  [[nodiscard]] bool has_exact_displacement() const { return exact_ != nullptr; }
 
   [[nodiscard]] const TriangleMesh& mesh() const { return mesh_; }
   [[nodiscard]] const std::vector<Vec<2>>& positions() const { return x_; }
@@ -63,7 +68,7 @@ class Solver {
 
   /// Restart: the state a checkpoint holds.
   struct State {
-    double time = 0.0, external_work = 0.0;
+    double time = 0.0, external_work = 0.0, error_now = 0.0, error_max = 0.0;
     long long step = 0;
     std::vector<Vec<2>> x, v, a, b, reaction;  ///< b: body force; reaction: condition forces
     std::vector<Mat3> F, tau;
@@ -101,7 +106,9 @@ class Solver {
   std::vector<Vec<2>> element_force_;  ///< 3 per element
   int n_state_ = 0;
   // loads and conditions
-  std::unique_ptr<ExpressionVector<2>> body_force_;
+  std::unique_ptr<ExpressionVector<2>> body_force_, exact_;
+  double error_now_ = 0.0, error_max_ = 0.0;
+  void measure_error();
   std::vector<NodeCondition> conditions_;
   double time_ = 0.0, external_work_ = 0.0;
   long long step_ = 0;

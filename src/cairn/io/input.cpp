@@ -1394,6 +1394,7 @@ void Loader::read_fem(const toml::table& root, Config& cfg) {
   f.velocity = r.expressions("velocity", n);
   if (f.velocity.empty()) f.velocity.assign(n, "0");
   f.displacement = r.expressions("displacement", n);
+  f.exact_displacement = r.expressions("exact_displacement", n);
   for (int face = 0; face < 2 * dim_; ++face)
     if (cfg.boundary.face[face] == FaceCondition::periodic)
       fail({"boundary", face_names[face]}, nullptr, "fixed, symmetry or free in an FEM run", "\"periodic\"");
@@ -1641,6 +1642,8 @@ std::string config_to_toml(const Config& c) {
     line("mesher", toml_string(f.mesher));
     line("velocity", array_text(f.velocity, expression_text));
     if (!f.displacement.empty()) line("displacement", array_text(f.displacement, expression_text));
+    if (!f.exact_displacement.empty())
+      line("exact_displacement", array_text(f.exact_displacement, expression_text));
   }
 
   o += "\n[boundary]\n";
