@@ -9,6 +9,7 @@
 
 #include <iostream>
 
+#include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
@@ -33,6 +34,13 @@ void describe_setup(const cairn::Config& config) {
 }
 
 void describe(const cairn::Config& config) {
+  if (config.fem.enabled) {
+    const cairn::fem::Solver solver(config);
+    fmt::print("# fem mesh ({}): {} nodes, {} triangles\n", solver.mesh().source, solver.mesh().n_nodes(),
+               solver.mesh().n_elements());
+    fmt::print("# first time step: {:.6g}\n", solver.next_dt());
+    return;
+  }
   switch (config.simulation.dimension) {
     case 1: describe_setup<1>(config); break;
     case 2: describe_setup<2>(config); break;

@@ -215,6 +215,9 @@ std::string fem_case(const std::string& mesh, const fs::path& out) {
 
 TEST_F(FemDir, CliRunWritesHistoryXdmfAndRestartsBitIdentically) {
   write("case.toml", fem_case("shape = { box = { min = [0.0, 0.0], max = [0.1, 0.05] } }\nsize = 0.01", dir_ / "out"));
+  ASSERT_EQ(cli("check " + (dir_ / "case.toml").string()), 0) << read(dir_ / "log.txt");
+  EXPECT_NE(read(dir_ / "log.txt").find("# fem mesh (generated box mesh): "), std::string::npos)
+      << read(dir_ / "log.txt");
   ASSERT_EQ(cli("run -q " + (dir_ / "case.toml").string()), 0) << read(dir_ / "log.txt");
   const std::string history = read(dir_ / "out" / "history.csv");
   EXPECT_EQ(history.substr(0, history.find('\n')),
