@@ -58,6 +58,21 @@ TEST(FemSolver, PatchTestLinearFieldGivesConstantStress) {
   (void)hi;
 }
 
+// Plane stress: the same patch, F_zz solves tau_zz = 0 in every element (the MPM's solver).
+TEST(FemSolver, PlaneStressPatchHasNoOutOfPlaneStress) {
+  const Config c = test::fem_config(
+      "shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\nsize = 0.25\n"
+      "displacement = [\"0.05*X\", \"0.02*Y\"]\n",
+      "", 1.0e4, 0.3, "plane_stress");
+  const Solver s(c);
+  const double fzz = s.deformation_gradients().front()(2, 2);
+  EXPECT_LT(fzz, 1.0);  // stretched in-plane: thinner
+  for (std::size_t e = 0; e < s.mesh().n_elements(); ++e) {
+    EXPECT_LT(std::abs(s.kirchhoff_stresses()[e](2, 2)), 1e-9 * s.kirchhoff_stresses()[e].norm());
+    EXPECT_NEAR(s.deformation_gradients()[e](2, 2), fzz, 1e-12);
+  }
+}
+
 // Eq. A2: each node carries a third of the mass of its elements; the total is rho * area.
 TEST(FemSolver, LumpedMassSumsToTotalMass) {
   for (const char* mesher : {"gmsh", "structured"}) {
