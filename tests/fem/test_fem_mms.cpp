@@ -56,15 +56,32 @@ double mms_error(double size, const std::string& mesher) {
   return err;
 }
 
+/// Order 2 asserted as > 1.8. Structured meshes are nested refinements of one pattern: every
+/// pair of successive meshes must show it. Gmsh's meshes of a sequence are not nested (the element
+/// shapes differ from mesh to mesh), so their order is the least-squares slope of log error
+/// against log h over the sequence; the pairwise orders are printed for both.
+void check_orders(const std::string& label, const std::string& mesher, const std::vector<double>& sizes,
+                  const std::vector<double>& errors) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const auto n = static_cast<double>(sizes.size());
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    const double x = std::log(sizes[k]), y = std::log(errors[k]);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+    if (k + 1 == sizes.size()) break;
+    const double order = std::log(errors[k] / errors[k + 1]) / std::log(sizes[k] / sizes[k + 1]);
+    std::printf("%s %s h = %.5g -> %.5g: L_inf %.4e -> %.4e, order %.3f\n", label.c_str(), mesher.c_str(), sizes[k],
+                sizes[k + 1], errors[k], errors[k + 1], order);
+    if (mesher == "structured") EXPECT_GT(order, 1.8) << label << " " << mesher << " h = " << sizes[k + 1];
+  }
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  std::printf("%s %s least-squares order %.3f\n", label.c_str(), mesher.c_str(), slope);
+  if (mesher != "structured") EXPECT_GT(slope, 1.8) << label << " " << mesher;
+}
+
 void expect_second_order(const std::string& mesher, const std::vector<double>& sizes) {
   std::vector<double> errors;
   for (double h : sizes) errors.push_back(mms_error(h, mesher));
-  for (std::size_t k = 0; k + 1 < sizes.size(); ++k) {
-    const double order = std::log(errors[k] / errors[k + 1]) / std::log(sizes[k] / sizes[k + 1]);
-    std::printf("%s h = %.5g -> %.5g: L_inf %.4e -> %.4e, order %.3f\n", mesher.c_str(), sizes[k], sizes[k + 1],
-                errors[k], errors[k + 1], order);
-    EXPECT_GT(order, 1.8) << mesher << " h = " << sizes[k + 1];
-  }
+  check_orders("square", mesher, sizes, errors);
 }
 
 TEST(FemMms, SecondOrderInDisplacementStructured) { expect_second_order("structured", {1.0 / 8, 1.0 / 16, 1.0 / 32}); }
@@ -80,12 +97,7 @@ void expect_ring_second_order(const std::string& mesher, const std::vector<doubl
     while (s.time() < c.simulation.end_time * (1 - 1e-12)) s.step(s.next_dt());
     errors.push_back(s.displacement_error_max());
   }
-  for (std::size_t k = 0; k + 1 < sizes.size(); ++k) {
-    const double order = std::log(errors[k] / errors[k + 1]) / std::log(sizes[k] / sizes[k + 1]);
-    std::printf("ring %s h = %.4g -> %.4g: L_inf %.4e -> %.4e, order %.3f\n", mesher.c_str(), sizes[k],
-                sizes[k + 1], errors[k], errors[k + 1], order);
-    EXPECT_GT(order, 1.8) << mesher << " h = " << sizes[k + 1];
-  }
+  check_orders("ring", mesher, sizes, errors);
 }
 
 TEST(FemMms, RingSecondOrderInDisplacement) { expect_ring_second_order("structured", {0.1, 0.05, 0.025}); }

@@ -331,12 +331,15 @@ double Solver::next_dt() const {
   double dt = s.fixed_dt;
   if (dt <= 0.0) {
     double h = std::numeric_limits<double>::infinity(), c = 0.0, vmax = 0.0;
-    for (std::size_t e = 0; e < mesh_.n_elements(); ++e) {
-      const auto& t = mesh_.triangles[e];
+    const auto ne = static_cast<std::int64_t>(mesh_.n_elements()), nn = static_cast<std::int64_t>(v_.size());
+#pragma omp parallel for reduction(min : h) reduction(max : c)
+    for (std::int64_t e = 0; e < ne; ++e) {
+      const auto& t = mesh_.triangles[static_cast<std::size_t>(e)];
       h = std::min(h, altitude(x_[t[0]], x_[t[1]], x_[t[2]]));
-      c = std::max(c, material_->wave_speed(F_[e]));
+      c = std::max(c, material_->wave_speed(F_[static_cast<std::size_t>(e)]));
     }
-    for (const auto& v : v_) vmax = std::max(vmax, v.norm());
+#pragma omp parallel for reduction(max : vmax)
+    for (std::int64_t i = 0; i < nn; ++i) vmax = std::max(vmax, v_[static_cast<std::size_t>(i)].norm());
     dt = s.cfl * h / (c + vmax);  // seed 001 Eq. 34
   }
   const double remaining = s.end_time - time_;
