@@ -162,6 +162,9 @@ TEST_F(FemDir, InputErrorsForFemKeys) {
                 "[grid]\norigin = [0.0, 0.0]\nextent = [1.0, 1.0]\ncell_size = 0.1\n")
                 .find("no [grid] in an FEM run"),
             std::string::npos);
+  EXPECT_NE(bad("shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\nsize = 0.1\n", "[method]\nshape = \"linear\"\n")
+                .find("no [method] in an FEM run"),
+            std::string::npos);
   EXPECT_NE(bad("shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\nsize = 0.1\nmaterial_x = 1\n")
                 .find("material_x"),
             std::string::npos);

@@ -1336,7 +1336,7 @@ void Loader::read_walls(const toml::table& root, Config& cfg) {
 void Loader::read_fem(const toml::table& root, Config& cfg) {
   // An FEM run has no grid and no particles: the sections that describe them, or features the
   // FEM does not implement, are errors rather than silently ignored.
-  for (const char* other : {"grid", "body", "traction", "wall", "contact", "contact_pair", "thermal"})
+  for (const char* other : {"grid", "method", "body", "traction", "wall", "contact", "contact_pair", "thermal"})
     if (const toml::node* node = root.get(other))
       fail({other}, node,
            fmt::format("no [{}] in an FEM run ([fem] meshes the body; docs/fem.md lists what the FEM "
@@ -1574,23 +1574,23 @@ std::string config_to_toml(const Config& c) {
     line("origin", reals_text(c.grid.origin));
     line("extent", reals_text(c.grid.extent));
     line("cell_size", reals_text(c.grid.cell_size));
-  }
 
-  const auto& m = c.method;
-  o += "\n[method]\n";
-  line("shape", toml_string(m.shape));
-  line("update", toml_string(m.update));
-  line("order", fmt::format("{}", m.order));
-  line("stress_update", toml_string(m.stress_update));
-  line("smoothing_length", real_text(m.smoothing_length));
-  line("cpdi_max_span", real_text(m.cpdi_max_span));
-  line("beta", real_text(m.beta));
-  line("blend_position", toml_string(m.blend_position));
-  line("grid_damping", real_text(m.grid_damping));
-  line("particle_damping", real_text(m.particle_damping));
-  line("full_mass_cfl", real_text(m.full_mass_cfl));
-  line("velocity_bc_method", toml_string(m.velocity_bc_method));
-  line("time_integration", toml_string(m.time_integration));
+    const auto& m = c.method;
+    o += "\n[method]\n";
+    line("shape", toml_string(m.shape));
+    line("update", toml_string(m.update));
+    line("order", fmt::format("{}", m.order));
+    line("stress_update", toml_string(m.stress_update));
+    line("smoothing_length", real_text(m.smoothing_length));
+    line("cpdi_max_span", real_text(m.cpdi_max_span));
+    line("beta", real_text(m.beta));
+    line("blend_position", toml_string(m.blend_position));
+    line("grid_damping", real_text(m.grid_damping));
+    line("particle_damping", real_text(m.particle_damping));
+    line("full_mass_cfl", real_text(m.full_mass_cfl));
+    line("velocity_bc_method", toml_string(m.velocity_bc_method));
+    line("time_integration", toml_string(m.time_integration));
+  }
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";
