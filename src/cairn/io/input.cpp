@@ -1503,10 +1503,10 @@ void Loader::read_fem(const toml::table& root, Config& cfg) {
            " (the structured mesher makes boxes and annuli)", toml_string(f.mesher));
   if (f.mesher == "structured" && f.hole_radius > 0.0)
     r.fail("mesher", r.given("mesher"), "\"gmsh\" for a shape with a hole", toml_string(f.mesher));
-  f.velocity = r.expressions("velocity", n);
+  f.velocity = r.expressions("velocity", n, ExpressionVars::initial);
   if (f.velocity.empty()) f.velocity.assign(n, "0");
-  f.displacement = r.expressions("displacement", n);
-  f.exact_displacement = r.expressions("exact_displacement", n);
+  f.displacement = r.expressions("displacement", n, ExpressionVars::initial);
+  f.exact_displacement = r.expressions("exact_displacement", n, ExpressionVars::field);
   for (int face = 0; face < 2 * dim_; ++face)
     if (cfg.boundary.face[face] == FaceCondition::periodic)
       fail({"boundary", face_names[face]}, nullptr, "fixed, symmetry or free in an FEM run", "\"periodic\"");
