@@ -26,6 +26,7 @@ S1 = 1.44
 G = 76e9          # nickel shear modulus (not given in the seeds; plasticity bounds its effect)
 YIELD = 0.5e9     # nickel-like yield stress: keeps deviatoric stress below 0.5 % of p_H
 CV = 440.0        # heat capacity (J/(kg K)) of the material input below
+CONDUCTIVITY = 90.7  # W/(m K), nickel (not in the seeds), used when conduction is on
 T0 = 298.15       # initial temperature (K)
 LENGTH = 50e-3
 WIDTH = 2.5e-3
@@ -61,9 +62,9 @@ def hugoniot_temperature(v_impact: float, cv: float = CV, t0: float = T0, n: int
 
 def case_input(run_dir: Path, v_impact: float, end_time: float, update: str, order: int,
                a1: float = 0.4, a2: float = 4.0, shape: str = "b2cpdi", every: float | None = None,
-               yield_stress: float = YIELD) -> dict:
+               yield_stress: float = YIELD, conduction: bool = False) -> dict:
     d = 1.5
-    return {
+    doc = {
         "simulation": {"title": f"nickel shock {update}({order}) v = {v_impact}", "dimension": 2,
                        "mode": "plane_strain", "end_time": end_time, "cfl": 0.2},
         "grid": {"origin": [-1e-3, -1e-3], "extent": [53e-3, 4.5e-3], "cell_size": CELL},
@@ -82,6 +83,10 @@ def case_input(run_dir: Path, v_impact: float, end_time: float, update: str, ord
         ],
         "output": {"directory": str(run_dir), "every": every if every else end_time},
     }
+    if conduction:  # seed 000 Sec. 3.5: "coupled heat conduction"
+        doc["thermal"] = {"conduction": True}
+        doc["material"][0]["conductivity"] = CONDUCTIVITY
+    return doc
 
 
 def profile(snapshot: Path, field: str = "pressure"):
