@@ -131,8 +131,11 @@ TEST(MieGruneisen, ArtificialViscosityHasTheValueOfSeed004Eq52) {
     const Mat3 diff = ta - tb;  // = J q I
     for (int i = 0; i < 3; ++i) {
       EXPECT_NEAR(diff(i, i) / J, expected, 1e-6 * expected) << "A1 = " << a1 << ", A2 = " << a2;
-      for (int j = 0; j < 3; ++j)
-        if (j != i) EXPECT_NEAR(diff(i, j), 0.0, 1e-9 * expected);
+      for (int j = 0; j < 3; ++j) {
+        if (j != i) {
+          EXPECT_NEAR(diff(i, j), 0.0, 1e-9 * expected);
+        }
+      }
     }
   }
 }
