@@ -1,8 +1,10 @@
 // The `cairn` command: run, check, keys, restart.
 //
-// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found); 3 the simulation
-// failed (which particle, step, time and quantity), after writing its last good output;
-// 1 anything else (an I/O failure, an internal error).
+// Exit codes: 0 success (also --help, --version); 2 bad input (file, line, key, expected vs.
+// found) or a bad command line (no or unknown subcommand, unknown option: a usage line follows);
+// 3 the simulation failed (which particle, step, time and quantity), after writing its last good
+// output; 1 anything else (an I/O failure, an internal error, or SIGINT/SIGTERM, after writing
+// checkpoint-autosave.h5).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
@@ -65,6 +67,13 @@ void print_summary(const cairn::RunSummary& s) {
   }
 }
 
+constexpr const char* usage =
+    "usage: cairn run INPUT.toml [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn check INPUT.toml [--set section.key=value]...\n"
+    "       cairn restart CHECKPOINT.h5 [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn keys [--markdown]\n"
+    "       cairn --help | --version\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,7 +106,19 @@ int main(int argc, char** argv) {
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
   restart->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::string what = e.what();
+    if (argc < 2) {
+      what = "no command given";
+    } else if (app.get_subcommands().empty()) {
+      what = fmt::format("unknown command or option '{}'", argv[1]);
+    }
+    std::cerr << "cairn: " << what << "\n" << usage;
+    return 2;
+  }
   if (threads > 0) omp_set_num_threads(threads);
 
   try {
@@ -134,6 +155,9 @@ int main(int argc, char** argv) {
   } catch (const cairn::RunFailure& e) {
     std::cerr << "cairn: " << e.what() << "\n";
     return 3;
+  } catch (const cairn::RunInterrupted& e) {
+    std::cerr << "cairn: " << e.what() << "\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "cairn: error: " << e.what() << "\n";
     return 1;
