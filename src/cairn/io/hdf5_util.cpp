@@ -376,11 +376,13 @@ bool has_attribute(hid_t obj, const std::string& name) {
 }
 
 void write_string_attribute(hid_t obj, const std::string& name, const std::string& value) {
-  Handle type = string_type(value.size(), obj, name);
+  // Variable-length UTF-8: h5py and other readers return it as a str, not as bytes.
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
+  check(H5Tset_size(type.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "cannot set the character set for", obj, name);
   Handle space = scalar_space(obj, name);
-  std::string buffer = value;
-  buffer.resize(std::max<std::size_t>(value.size(), 1), '\0');
-  write_attribute(obj, name, type.get(), type.get(), space.get(), buffer.data());
+  const char* text = value.c_str();
+  write_attribute(obj, name, type.get(), type.get(), space.get(), &text);
 }
 
 void write_double_attribute(hid_t obj, const std::string& name, double value) {
@@ -407,6 +409,7 @@ std::string read_string_attribute(hid_t obj, const std::string& name) {
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
     check(H5Tset_size(mtype.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+    check(H5Tset_cset(mtype.get(), H5Tget_cset(type.get())), "cannot set the character set for", obj, name);
     char* text = nullptr;
     check(H5Aread(attr.get(), mtype.get(), &text), "cannot read attribute", obj, name);
     std::string value = text != nullptr ? std::string(text) : std::string();

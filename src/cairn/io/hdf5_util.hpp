@@ -110,7 +110,7 @@ void write_text_list(hid_t loc, const std::string& name, const std::vector<std::
 
 /// Whether the object `obj` (file, group or dataset) has an attribute `name`.
 [[nodiscard]] bool has_attribute(hid_t obj, const std::string& name);
-/// Attach a string attribute (fixed-length) to `obj`.
+/// Attach a string attribute (variable-length UTF-8) to `obj`.
 void write_string_attribute(hid_t obj, const std::string& name, const std::string& value);
 /// Attach a scalar double attribute to `obj`.
 void write_double_attribute(hid_t obj, const std::string& name, double value);
