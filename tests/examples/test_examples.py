@@ -72,6 +72,16 @@ def disk_wall(cairn, source, out):
     p0, p1 = h["momentum_x"][0], h["momentum_x"][-1]
     check(p0 > 0 and p1 < -0.5 * p0, f"disk_wall: momentum_x {p0:.4g} -> {p1:.4g} (rebound above half the speed)")
     check(h["contact_wall_disk_x"].max() > 0, f"disk_wall: the disk pushed the wall (+x), up to {h['contact_wall_disk_x'].max():.4g} N")
+    # docs/output.md describes every column and array this run wrote.
+    with open(os.path.join(source, "docs", "output.md")) as f:
+        doc = f.read()
+    generic = {"contact_wall_disk_x": "contact_<a>_<b>_<axis>", "contact_wall_disk_y": "contact_<a>_<b>_<axis>"}
+    missing = [c for c in h if f"`{generic.get(c, c)}`" not in doc]
+    check(not missing, f"disk_wall: docs/output.md lists every history.csv column (missing: {missing})")
+    with h5py.File(sorted(glob.glob(os.path.join(out, "snapshots", "particles-*.h5")))[-1], "r") as f:
+        names = list(f.attrs) + [k for k in f if k != "particles"] + list(f["particles"])
+    missing = [n for n in names if f"`{n}`" not in doc and f"`/{n}`" not in doc and not n.startswith("deformation_gradient_")]
+    check(not missing, f"disk_wall: docs/output.md lists every snapshot attribute and dataset (missing: {missing})")
 
 
 def falling_cube(cairn, source, out):
