@@ -80,6 +80,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
   app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
   app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success; 2 bad input or command line; 3 the simulation failed (last good\n"
+      "output kept); 1 any other error, or interrupted by SIGINT/SIGTERM (after writing\n"
+      "checkpoint-autosave.h5). A first simulation: docs/tutorial.md; the files: docs/output.md.");
 
   std::string input;
   std::vector<std::string> overrides;
