@@ -3,13 +3,14 @@
 // Exit codes: 0 success (also --help, --version); 2 bad input (file, line, key, expected vs.
 // found) or a bad command line (no or unknown subcommand, unknown option: a usage line follows);
 // 3 the simulation failed (which particle, step, time and quantity), after writing its last good
-// output; 1 anything else (an I/O failure, an internal error, or SIGINT/SIGTERM, after writing
+// output; 1 anything else (an I/O failure such as a full disk, an internal error, or SIGINT/SIGTERM, after writing
 // checkpoint-autosave.h5).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
 
 #include <iostream>
+#include <new>
 
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
@@ -74,6 +75,13 @@ constexpr const char* usage =
     "       cairn keys [--markdown]\n"
     "       cairn --help | --version\n";
 
+void print_warnings(const cairn::Config& config) {
+  for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
+}
+
+/// Largest -t: as simulation.threads (io/schema.cpp).
+constexpr int max_threads = 1024;
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -95,7 +103,8 @@ int main(int argc, char** argv) {
   run->add_option("input", input, "input file")->required();
   run->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
   run->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  run->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+  run->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+      ->check(CLI::Range(0, max_threads));
 
   auto* check = app.add_subcommand("check", "validate an input file and print the resolved settings");
   check->add_option("input", input, "input file")->required();
@@ -108,7 +117,8 @@ int main(int argc, char** argv) {
   restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
   restart->add_option("--set", overrides, "override an input key of the stored input");
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  restart->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+  restart->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+      ->check(CLI::Range(0, max_threads));
 
   try {
     app.parse(argc, argv);
@@ -132,6 +142,7 @@ int main(int argc, char** argv) {
     }
     if (*check) {
       const cairn::Config config = cairn::load_config(input, overrides);
+      print_warnings(config);
       std::cout << config.resolved_toml;
       describe(config);
       return 0;
@@ -141,6 +152,7 @@ int main(int argc, char** argv) {
     cairn::RunSummary summary;
     if (*run) {
       const cairn::Config config = cairn::load_config(input, overrides);
+      print_warnings(config);
       summary = cairn::run(config, options);
     } else {
       summary = cairn::restart(input, overrides, options);
@@ -161,6 +173,9 @@ int main(int argc, char** argv) {
     return 3;
   } catch (const cairn::RunInterrupted& e) {
     std::cerr << "cairn: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "cairn: error: " << e.what() << "\n";

@@ -173,10 +173,14 @@ TEST(AtomicFile, WriteLeavesNoTempFile) {
   EXPECT_EQ(list_dir(target.parent_path()), std::vector<std::string>{"a.txt"});
 }
 
-TEST(AtomicFile, TempPathIsNextToTarget) {
-  const fs::path tmp = atomic_temp_path("/some/dir/file.h5");
-  EXPECT_EQ(tmp.parent_path(), fs::path("/some/dir"));
-  EXPECT_EQ(tmp.filename().string(), "file.h5.tmp." + std::to_string(::getpid()));
+TEST(AtomicFile, TempFileIsNewAndNextToTarget) {
+  TempDir dir;
+  const fs::path target = dir.path() / "file.h5";
+  const fs::path a = create_atomic_temp(target), b = create_atomic_temp(target);
+  EXPECT_EQ(a.parent_path(), dir.path());
+  EXPECT_EQ(a.filename().string().rfind("file.h5.tmp." + std::to_string(::getpid()) + ".", 0), 0u);
+  EXPECT_NE(a, b);
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(a)));
 }
 
 TEST(AtomicFile, ExceptionKeepsOldTarget) {
@@ -724,11 +728,12 @@ TYPED_TEST(CheckpointTest, VectorsAreStoredWithThreeComponents) {
     EXPECT_EQ(back.particles.size0[p], data.particles.size0[p]);
   }
 
-  // A version-1 checkpoint stored the vectors as n x D; it still reads.
+  // A version-1 checkpoint stored the vectors as n x D (and had no checksum); it still reads.
   {
     h5::Handle f(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
     ASSERT_GE(f.get(), 0);
     h5::write_int64_attribute(f.get(), "version", 1);
+    ASSERT_GE(H5Adelete(f.get(), "checksum"), 0);
     h5::Handle g = h5::open_group(f.get(), "particles");
     ASSERT_GE(H5Ldelete(g.get(), "velocity", H5P_DEFAULT), 0);
     std::vector<double> v;

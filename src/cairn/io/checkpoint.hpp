@@ -6,6 +6,7 @@
 //
 // File layout (format "cairn-checkpoint", version 2; version 1 files are still read):
 //   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index,
+//     checksum (io/checksum.hpp: over everything else; a mismatch is refused on reading),
 //     and the metadata of snapshots (cairn_version, title, units, unit_*, input_sha256 of
 //     /config_toml); /material_names, /body_names (string lists)
 //   /config_toml                         scalar string

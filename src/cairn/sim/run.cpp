@@ -10,12 +10,14 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <exception>
 #include <regex>
 
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -139,7 +141,21 @@ class Runner {
     remove_orphan_temporaries(dir_ / "snapshots");
   }
 
+  /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
+  /// computed so far in history.csv.
+  ~Runner() {
+    if (std::uncaught_exceptions() == 0) return;
+    try {
+      history_writer_.flush();
+    } catch (const std::exception&) {
+      // the exception in flight says what went wrong
+    }
+  }
+  Runner(const Runner&) = delete;
+  Runner& operator=(const Runner&) = delete;
+
   void restore(const CheckpointData<D>& data) {
+    check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
     sim_.particles() = data.particles;
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
@@ -178,7 +194,7 @@ class Runner {
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
-        fail(f);
+        fail(f, dt);
       }
       last_dt_ = dt;
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
@@ -322,12 +338,13 @@ class Runner {
                                      sim_.step_count(), sim_.time(), saved, dir_.string()));
   }
 
-  [[noreturn]] void fail(const SimulationFailure& f) {
+  /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
+  [[noreturn]] void fail(const SimulationFailure& f, double dt) {
     history_writer_.flush();
     std::string saved;
     try {
       SnapshotWriter<D> failure(dir_, "failure", meta_);
-      failure.write(sim_.particles(), sim_.time(), sim_.step_count());
+      failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
       saved = "; the failed state could not be written";
