@@ -12,6 +12,7 @@
 #include <iostream>
 #include <new>
 
+#include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
@@ -36,6 +37,13 @@ void describe_setup(const cairn::Config& config) {
 }
 
 void describe(const cairn::Config& config) {
+  if (config.fem.enabled) {
+    const cairn::fem::Solver solver(config);
+    fmt::print("# fem mesh ({}): {} nodes, {} triangles\n", solver.mesh().source, solver.mesh().n_nodes(),
+               solver.mesh().n_elements());
+    fmt::print("# first time step: {:.6g}\n", solver.next_dt());
+    return;
+  }
   switch (config.simulation.dimension) {
     case 1: describe_setup<1>(config); break;
     case 2: describe_setup<2>(config); break;
@@ -44,11 +52,11 @@ void describe(const cairn::Config& config) {
 }
 
 void print_summary(const cairn::RunSummary& s) {
-  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} particle-steps/s with {} threads, "
-             "{} particles)\n",
-             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, omp_get_max_threads(),
-             s.n_particles);
-  fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {} threads, "
+             "{} {}s)\n",
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, omp_get_max_threads(),
+             s.n_particles, s.item);
+  fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;
   for (const auto& [name, sec] : s.stage_seconds) total += sec;

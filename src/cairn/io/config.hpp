@@ -206,6 +206,25 @@ struct ContactConfig {
   [[nodiscard]] bool enabled() const { return mode != "none"; }
 };
 
+/// [fem]: the reference explicit FEM of seed 001 Appendix A (docs/fem.md). When enabled the run
+/// has no grid and no particles: [grid] and [[body]] are absent and the mesh is the body.
+struct FemConfig {
+  bool enabled = false;
+  std::string material;             ///< name of a [[material]]
+  std::string mesh_file;            ///< Gmsh .msh file (absolute once loaded); "" = generate from shape
+  BodyShapeConfig shape;            ///< generated mesh: box | circle | ellipse | annulus | polygon
+  std::vector<double> hole_center;  ///< D values: circular hole cut from the shape; empty = none
+  double hole_radius = 0.0;
+  double size = 0.0;                ///< characteristic element size of generated meshes
+  std::string mesher = "gmsh";      ///< gmsh | structured
+  std::vector<std::string> velocity;      ///< D expressions in X,Y: initial velocity
+  std::vector<std::string> displacement;  ///< D expressions in X,Y; empty = none
+  /// D expressions in X,Y,t: an exact displacement; history.csv then gets the node error of
+  /// seed 001 Eq. 38 every step (displacement_error, and its maximum over all steps so far).
+  std::vector<std::string> exact_displacement;
+  SourceLocation where;
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -234,6 +253,7 @@ struct Config {
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
   ThermalConfig thermal;
   ContactConfig contact;
+  FemConfig fem;
   OutputConfig output;
   /// Values that are valid but suspicious (e.g. a density of 1e308), one message each with file,
   /// line and key; the CLI prints them.

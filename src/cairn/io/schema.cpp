@@ -523,6 +523,43 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("1.0")
                 .min(above_zero));
 
+  // [fem] (docs/fem.md, seed 001 Appendix A)
+  k.push_back(Key("fem", "material", T::string,
+                 "Name of the [[material]] of the meshed body.")
+                .required());
+  k.push_back(Key("fem", "mesh_file", T::string,
+                 "Gmsh .msh file (relative to the input file) read through the Gmsh API; its "
+                 "3-node triangles are the mesh. Give either mesh_file or shape.")
+                .by_default("\"\""));
+  k.push_back(Key("fem", "shape", T::table,
+                 "Generated mesh: an inline table with one shape kind as in [[body]] (box, circle, "
+                 "ellipse, annulus, polygon)."));
+  k.push_back(Key("fem", "hole_center", T::real_array,
+                 "Centre of a circular hole cut from the generated shape (plate with a hole)."));
+  k.push_back(Key("fem", "hole_radius", T::real,
+                 "Radius of the hole; 0 = no hole.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("fem", "size", T::real,
+                 "Characteristic element size (edge length) of a generated mesh; halve it for the "
+                 "next mesh of a refinement sequence.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("fem", "mesher", T::string,
+                 "gmsh: unstructured Frontal-Delaunay triangles from the Gmsh API; structured: a "
+                 "mapped mesh (boxes: crossed-diagonal quads; annuli: polar quads split in two).")
+                .by_default("\"gmsh\"")
+                .choices([] { return std::vector<std::string>{"gmsh", "structured"}; }));
+  k.push_back(Key("fem", "velocity", T::expression_array,
+                 "Initial node velocity, one entry per axis: numbers or expressions in X, Y "
+                 "(reference position) and [constants]; default zeros."));
+  k.push_back(Key("fem", "displacement", T::expression_array,
+                 "Initial node displacement, entries as for velocity; default none."));
+  k.push_back(Key("fem", "exact_displacement", T::expression_array,
+                 "Exact displacement u(X, Y, t) of a manufactured solution; history.csv then has "
+                 "displacement_error (max over nodes of |x - X - u|, seed 001 Eq. 38, every step) and "
+                 "displacement_error_max (its maximum over all steps so far); default none."));
+
   // [output]
   k.push_back(Key("output", "directory", T::string,
                  "Output folder; \"\" = out/<input file stem>. A relative folder lies next to the "
@@ -761,6 +798,18 @@ const std::vector<SectionDoc>& section_docs() {
        "first = \"steel\"\n"
        "second = \"rock\"\n"
        "law = \"perfect\"\n"},
+      {"fem", "[fem]",
+       "The reference explicit FEM of seed 001 Appendix A on linear triangles (docs/fem.md). With "
+       "[fem] the run has no grid and no particles: no [grid], [[body]], [[traction]], [[wall]], "
+       "[contact] or [thermal]. [boundary] faces apply to the nodes on the faces of the mesh's "
+       "bounding box, [[velocity]] selects nodes by face, box or plane, [body_force] acts on the "
+       "nodes (expressions of X, Y, x, y, t).",
+       "[fem]\n"
+       "material = \"steel\"\n"
+       "shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\n"
+       "hole_center = [0.0, 0.0]\n"
+       "hole_radius = 0.5\n"
+       "size = 0.02\n"},
       {"output", "[output]",
        "What is written, where and how often.",
        "[output]\n"
@@ -1072,7 +1121,7 @@ const std::vector<std::string>& section_names() {
                                               "constants",  "material", "body",
                                               "boundary",   "thermal",    "body_force", "traction",
                                               "velocity",   "wall",       "contact",    "contact_pair",
-                                              "output"};
+                                              "fem",        "output"};
   return names;
 }
 

@@ -13,6 +13,8 @@
 #include <exception>
 #include <regex>
 
+#include "cairn/fem/output.hpp"
+#include "cairn/fem/run.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
@@ -454,6 +456,7 @@ std::string time_step_note(const Config& config) {
 }
 
 RunSummary run(const Config& config, const RunOptions& options) {
+  if (config.fem.enabled) return fem::run(config, options);
   switch (config.simulation.dimension) {
     case 1: return run_dim<1>(config, options, nullptr);
     case 2: return run_dim<2>(config, options, nullptr);
@@ -489,6 +492,7 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
 
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
                    const RunOptions& options) {
+  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, overrides, options);
   switch (checkpoint_dimension(checkpoint)) {
     case 1: return restart_dim<1>(checkpoint, overrides, options);
     case 2: return restart_dim<2>(checkpoint, overrides, options);
