@@ -469,6 +469,15 @@ template <int D>
 RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
                        const RunOptions& options) {
   const CheckpointData<D> data = read_checkpoint<D>(file);
+  const Config config = load_config_string(data.config_toml, file.string(), overrides);
+  if (config.simulation.dimension != D)
+    throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+  return run_dim<D>(config, options, &data);
+}
+}  // namespace
+
+RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
+                   const RunOptions& options) {
   // The restarted run writes next to the checkpoint it was given (not into the folder stored in
   // it, which may belong to another run or machine), unless --set output.directory says where.
   std::vector<std::string> all = overrides;
@@ -478,25 +487,16 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
     directory_given = directory_given || key.find("output.directory") != std::string::npos;
   }
   if (!directory_given) {
-    std::string folder = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
+    const std::string folder = checkpoint.parent_path().empty() ? std::string(".") : checkpoint.parent_path().string();
     std::string quoted = "\"";
     for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
     all.push_back("output.directory=" + quoted + "\"");
   }
-  const Config config = load_config_string(data.config_toml, file.string(), all);
-  if (config.simulation.dimension != D)
-    throw std::invalid_argument("--set cannot change simulation.dimension on restart");
-  return run_dim<D>(config, options, &data);
-}
-}  // namespace
-
-RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
-                   const RunOptions& options) {
-  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, overrides, options);
+  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, all, options);
   switch (checkpoint_dimension(checkpoint)) {
-    case 1: return restart_dim<1>(checkpoint, overrides, options);
-    case 2: return restart_dim<2>(checkpoint, overrides, options);
-    default: return restart_dim<3>(checkpoint, overrides, options);
+    case 1: return restart_dim<1>(checkpoint, all, options);
+    case 2: return restart_dim<2>(checkpoint, all, options);
+    default: return restart_dim<3>(checkpoint, all, options);
   }
 }
 
