@@ -1,8 +1,10 @@
 // The `cairn` command: run, check, keys, restart.
 //
-// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found) or a bad command
-// line; 3 the simulation failed (which particle, step, time and quantity), after writing its
-// last good output; 1 anything else (an I/O failure such as a full disk, an internal error).
+// Exit codes: 0 success (also --help, --version); 2 bad input (file, line, key, expected vs.
+// found) or a bad command line (no or unknown subcommand, unknown option: a usage line follows);
+// 3 the simulation failed (which particle, step, time and quantity), after writing its last good
+// output; 1 anything else (an I/O failure such as a full disk, an internal error, or SIGINT/SIGTERM, after writing
+// checkpoint-autosave.h5).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
@@ -11,6 +13,7 @@
 #include <new>
 #include <sstream>
 
+#include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
@@ -36,6 +39,13 @@ void describe_setup(const cairn::Config& config) {
 }
 
 void describe(const cairn::Config& config) {
+  if (config.fem.enabled) {
+    const cairn::fem::Solver solver(config);
+    fmt::print("# fem mesh ({}): {} nodes, {} triangles\n", solver.mesh().source, solver.mesh().n_nodes(),
+               solver.mesh().n_elements());
+    fmt::print("# first time step: {:.6g}\n", solver.next_dt());
+    return;
+  }
   switch (config.simulation.dimension) {
     case 1: describe_setup<1>(config); break;
     case 2: describe_setup<2>(config); break;
@@ -48,13 +58,14 @@ void print_summary(const cairn::RunSummary& s) {
   const std::string workers =
       s.ranks > 1 ? fmt::format("{} MPI ranks x {} thread{}", s.ranks, threads, threads == 1 ? "" : "s")
                   : fmt::format("{} threads", threads);
-  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} particle-steps/s with {}, "
-             "{} particles)\n",
-             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, workers, s.n_particles);
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {}, "
+             "{} {}s)\n",
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, workers,
+             s.n_particles, s.item);
   if (s.ranks > 1)
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);
-  fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
+  fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;
   for (const auto& [name, sec] : s.stage_seconds) total += sec;
@@ -74,6 +85,13 @@ void print_summary(const cairn::RunSummary& s) {
   }
 }
 
+constexpr const char* usage =
+    "usage: cairn run INPUT.toml [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn check INPUT.toml [--set section.key=value]...\n"
+    "       cairn restart CHECKPOINT.h5 [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn keys [--markdown]\n"
+    "       cairn --help | --version\n";
+
 void print_warnings(const cairn::Config& config) {
   for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
 }
@@ -92,6 +110,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
   app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
   app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success; 2 bad input or command line; 3 the simulation failed (last good\n"
+      "output kept); 1 any other error, or interrupted by SIGINT/SIGTERM (after writing\n"
+      "checkpoint-autosave.h5). A first simulation: docs/tutorial.md; the files: docs/output.md.");
 
   std::string input;
   std::vector<std::string> overrides;
@@ -123,13 +145,23 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    std::ostringstream out, err;
-    const int code = app.exit(e, out, err);  // help, the version or the error
-    if (root) {
-      std::cout << out.str();
-      std::cerr << err.str();
+    if (e.get_exit_code() == 0) {  // --help, --version
+      std::ostringstream out, err;
+      const int code = app.exit(e, out, err);
+      if (root) {
+        std::cout << out.str();
+        std::cerr << err.str();
+      }
+      return code;
     }
-    return code == 0 ? 0 : 2;  // a bad command line is bad input
+    std::string what = e.what();
+    if (argc < 2) {
+      what = "no command given";
+    } else if (app.get_subcommands().empty()) {
+      what = fmt::format("unknown command or option '{}'", argv[1]);
+    }
+    if (root) std::cerr << "cairn: " << what << "\n" << usage;
+    return 2;
   }
   // Only rank 0 talks; the others' standard output and error stay quiet.
   std::ostringstream discard;
@@ -173,6 +205,9 @@ int main(int argc, char** argv) {
   } catch (const cairn::RunFailure& e) {
     err << "cairn: " << e.what() << "\n";
     return 3;
+  } catch (const cairn::RunInterrupted& e) {
+    err << "cairn: " << e.what() << "\n";
+    return 1;
   } catch (const std::bad_alloc&) {
     // Other ranks may be waiting in a collective call: on several ranks, stop them all.
     std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";

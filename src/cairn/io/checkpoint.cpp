@@ -19,37 +19,36 @@ namespace {
 constexpr const char* format_name = "cairn-checkpoint";
 
 // Particle arrays are written from the simulation's own storage: vectors directly (a Vec<D> is D
-// contiguous doubles), matrices (column-major in memory, row-major in the file) through a
-// bounded block buffer, so a checkpoint never holds a second copy of the particles.
+// contiguous doubles, stored n x 3 with zeros beyond D, the shape snapshots use: format version
+// 2), matrices (column-major in memory, row-major in the file) through a bounded block buffer,
+// so a checkpoint never holds a second copy of the particles.
 template <int D>
-void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, h5::Rows rows) {
+void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, h5::Rows rows, int deflate) {
   static_assert(sizeof(Vec<D>) == D * sizeof(double), "Vec<D> must be D packed doubles");
-  h5::write_doubles_rows(loc, name, v.empty() ? nullptr : v.front().data(), rows, D);
+  h5::write_doubles_padded(loc, name, v.empty() ? nullptr : v.front().data(), rows, D, 3, deflate);
 }
 
+/// Reads n x 3 (version 2) or n x D (version 1) vectors.
 template <int D>
+/// Rows [first, first + n) of n x 3 (version 2) or n x D (version 1) vectors.
 std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t first, std::size_t n) {
-  const std::vector<double> buffer = h5::read_doubles_rows(loc, name, first, n, static_cast<std::size_t>(D));
+  const std::vector<std::size_t> shape = h5::dataset_shape(loc, name);
+  const std::size_t cols = shape.size() == 2 && shape[1] == 3 ? 3 : static_cast<std::size_t>(D);
+  const std::vector<double> buffer = h5::read_doubles_rows(loc, name, first, n, cols);
   std::vector<Vec<D>> v(n);
   for (std::size_t p = 0; p < n; ++p)
-    for (int a = 0; a < D; ++a) v[p][a] = buffer[D * p + a];
+    for (int a = 0; a < D; ++a) v[p][a] = buffer[cols * p + a];
   return v;
 }
 
-void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m, h5::Rows rows) {
+/// Mat3 or SymMat3 per particle, n x 9 row-major.
+template <class M>
+void write_mats(hid_t loc, const std::string& name, const std::vector<M>& m, h5::Rows rows, int deflate) {
   h5::write_doubles_blocked(loc, name, rows, 9, [&](std::size_t first, std::size_t count, double* out) {
     for (std::size_t p = first; p < first + count; ++p)
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
-  });
-}
-
-void write_mats(hid_t loc, const std::string& name, const std::vector<SymMat3>& m, h5::Rows rows) {
-  h5::write_doubles_blocked(loc, name, rows, 9, [&](std::size_t first, std::size_t count, double* out) {
-    for (std::size_t p = first; p < first + count; ++p)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
-  });
+  }, deflate);
 }
 
 std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t first, std::size_t n) {
@@ -104,9 +103,9 @@ h5::Handle open_checkpoint(const fs::path& path, int& dimension) {
                              format + "', expected '" + format_name + "')");
   }
   const long long version = h5::read_int64_attribute(root, "version");
-  if (version != checkpoint_format_version) {
+  if (version < 1 || version > checkpoint_format_version) {
     throw std::runtime_error(fmt::format(
-        "checkpoint '{}' has format version {}, but this build of Cairn reads only version {}",
+        "checkpoint '{}' has format version {}, but this build of Cairn reads versions 1 to {}",
         path.string(), version, checkpoint_format_version));
   }
   const long long dim = h5::read_int64_attribute(root, "dimension");
@@ -158,6 +157,9 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     h5::write_double_attribute(root, "previous_dt", data.previous_dt);
     h5::write_int64_attribute(root, "snapshot_next_index", data.snapshot_next_index);
     h5::write_text(root, "config_toml", data.config_toml);
+    OutputMetadata meta = data.metadata;
+    meta.input_toml = data.config_toml;  // input_sha256 fingerprints /config_toml
+    h5::write_metadata(root, meta, false);
     {
       h5::Handle g = h5::create_group(root, "scalars");
       std::vector<std::string> names;
@@ -190,25 +192,26 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     }
     {
       const Particles<D>& ps = particles;
+      const int z = comm.parallel() ? 0 : data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
       h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);
-      write_vecs<D>(gid, "position", ps.position, rows);
-      write_vecs<D>(gid, "reference_position", ps.reference_position, rows);
-      write_vecs<D>(gid, "velocity", ps.velocity, rows);
+      write_vecs<D>(gid, "position", ps.position, rows, z);
+      write_vecs<D>(gid, "reference_position", ps.reference_position, rows, z);
+      write_vecs<D>(gid, "velocity", ps.velocity, rows, z);
       h5::write_doubles_rows(gid, "mass", ps.mass.data(), rows);
       h5::write_doubles_rows(gid, "volume0", ps.volume0.data(), rows);
       if (ps.has_temperature) h5::write_doubles_rows(gid, "temperature", ps.temperature.data(), rows);
-      write_vecs<D>(gid, "size0", ps.size0, rows);
-      write_mats(gid, "deformation_gradient", ps.deformation_gradient, rows);
-      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, rows);
-      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, rows);
+      write_vecs<D>(gid, "size0", ps.size0, rows, z);
+      write_mats(gid, "deformation_gradient", ps.deformation_gradient, rows, z);
+      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, rows, z);
+      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, rows, z);
       h5::write_ints_rows(gid, "material", ps.material.data(), rows);
       h5::write_ints_rows(gid, "body", ps.body.data(), rows);
       h5::write_int64s_rows(gid, "id", ps.id.data(), rows);
       const auto n_state = static_cast<std::size_t>(ps.n_state_per_particle);
       h5::write_doubles_rows(gid, "state", ps.state.data(),
-                             h5::Rows{rows.first * n_state, rows.count * n_state, rows.total * n_state});
+                             h5::Rows{rows.first * n_state, rows.count * n_state, rows.total * n_state}, 0, z);
     }
   }, checksum);  // the checksum last: it covers everything above
 }

@@ -65,18 +65,37 @@ Access access_of(hid_t loc) {
 
 hid_t transfer_of(const Access& a) { return a.parallel ? a.transfer.get() : H5P_DEFAULT; }
 
+/// Dataset creation properties: contiguous, or chunked with shuffle + gzip(`deflate`) when
+/// asked for and the dataset is large enough (whole rows per chunk, about 1 MiB).
+Handle creation_properties(const std::vector<hsize_t>& dims, std::size_t element_size, int deflate,
+                           hid_t loc, const std::string& name) {
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "cannot create properties for", loc, name);
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  if (deflate <= 0 || dims.empty() || total < min_compressed_elements) return dcpl;
+  std::vector<hsize_t> chunk = dims;
+  const hsize_t row = total / std::max<hsize_t>(dims[0], 1);
+  chunk[0] = std::clamp<hsize_t>((hsize_t{1} << 20) / (row * element_size), 1, dims[0]);
+  check(H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()), "cannot chunk", loc, name);
+  check(H5Pset_shuffle(dcpl.get()), "cannot set the shuffle filter for", loc, name);
+  check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(std::min(deflate, 9))), "cannot set gzip for", loc, name);
+  return dcpl;
+}
+
 /// Create dataset `name` of file type `ftype` over `dims` and write `data` (memory type `mtype`).
 /// In a parallel file every rank passes the same data and rank 0 writes it.
 void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
-                   const std::vector<hsize_t>& dims, const void* data) {
+                   const std::vector<hsize_t>& dims, const void* data, int deflate = 0) {
+  const Access a = access_of(loc);
+  if (a.parallel) deflate = 0;  // parallel files: no filters (docs/parallel.md)
   Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, H5Tget_size(ftype), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
-                                   H5P_DEFAULT, H5P_DEFAULT),
+                                   dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
   if (total > 0) {
-    const Access a = access_of(loc);
     Handle memory = simple_space(dims, loc, name);
     if (!a.root) {
       H5Sselect_none(space.get());
@@ -89,21 +108,28 @@ void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
 
 /// Create dataset `name` of `rows.total` x cols (cols = 0: 1D) and write this rank's rows.
 void write_dataset_rows(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype, Rows rows,
-                        std::size_t cols, const void* data) {
+                        std::size_t cols, const void* data, int deflate = 0) {
   std::vector<hsize_t> dims{rows.total};
   if (cols > 0) dims.push_back(cols);
+  const Access a = access_of(loc);
+  if (!a.parallel) {  // one process writes every row
+    if (rows.first != 0 || rows.count != rows.total) fail("a partial row range in a serial file for", loc, name);
+    write_dataset(loc, name, ftype, mtype, dims, data, deflate);
+    return;
+  }
   Handle space = simple_space(dims, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
                                    H5P_DEFAULT, H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   if (rows.total == 0) return;
-  const Access a = access_of(loc);
   const double dummy = 0.0;
   if (data == nullptr) data = &dummy;  // a rank without rows passes no buffer
   std::vector<hsize_t> start(dims.size(), 0), count = dims;
   start[0] = rows.first;
   count[0] = rows.count;
-  Handle memory = simple_space(count, loc, name);
+  std::vector<hsize_t> memory_dims = count;
+  memory_dims[0] = std::max<hsize_t>(count[0], 1);
+  Handle memory = simple_space(memory_dims, loc, name);
   if (rows.count > 0) {
     check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
           "cannot select rows of", loc, name);
@@ -278,32 +304,33 @@ bool has_child(hid_t loc, const std::string& name) {
 }
 
 void write_doubles(hid_t loc, const std::string& name, const double* data, std::size_t rows,
-                   std::size_t cols) {
+                   std::size_t cols, int deflate) {
   std::vector<hsize_t> dims{rows};
   if (cols > 0) dims.push_back(cols);
-  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, deflate);
 }
 
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
-                          const std::vector<std::size_t>& shape) {
+                          const std::vector<std::size_t>& shape, int deflate) {
   std::vector<hsize_t> dims(shape.begin(), shape.end());
-  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, deflate);
 }
 
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill) {
-  write_doubles_blocked(loc, name, Rows{0, rows, rows}, cols, fill);
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate) {
+  write_doubles_blocked(loc, name, Rows{0, rows, rows}, cols, fill, deflate);
 }
 
 void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill) {
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate) {
+  const Access a = access_of(loc);
   const std::vector<hsize_t> dims{rows.total, cols};
   Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), a.parallel ? 0 : deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
-                                   H5P_DEFAULT, H5P_DEFAULT),
+                                   dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   if (rows.total == 0 || cols == 0) return;
-  const Access a = access_of(loc);
   const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / cols);
   std::vector<double> buffer(std::max<std::size_t>(std::min(rows.count, block), 1) * cols);
   // Collective I/O: every rank takes part in the same number of writes (an empty selection
@@ -332,26 +359,33 @@ void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::s
   }
 }
 
-void write_doubles_rows(hid_t loc, const std::string& name, const double* data, Rows rows, std::size_t cols) {
-  write_dataset_rows(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rows, cols, data);
+void write_doubles_rows(hid_t loc, const std::string& name, const double* data, Rows rows, std::size_t cols,
+                        int deflate) {
+  write_dataset_rows(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rows, cols, data, deflate);
 }
 
-void write_ints_rows(hid_t loc, const std::string& name, const std::int32_t* data, Rows rows) {
-  write_dataset_rows(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, rows, 0, data);
+void write_ints_rows(hid_t loc, const std::string& name, const std::int32_t* data, Rows rows, int deflate) {
+  write_dataset_rows(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, rows, 0, data, deflate);
 }
 
-void write_int64s_rows(hid_t loc, const std::string& name, const std::int64_t* data, Rows rows) {
-  write_dataset_rows(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, rows, 0, data);
+void write_int64s_rows(hid_t loc, const std::string& name, const std::int64_t* data, Rows rows, int deflate) {
+  write_dataset_rows(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, rows, 0, data, deflate);
 }
 
 void write_doubles_box(hid_t loc, const std::string& name, const double* data, const std::vector<std::size_t>& shape,
-                       const std::vector<std::size_t>& start, const std::vector<std::size_t>& count) {
+                       const std::vector<std::size_t>& start, const std::vector<std::size_t>& count, int deflate) {
+  const Access a = access_of(loc);
+  if (!a.parallel) {  // one process: the box is the whole dataset
+    if (start != std::vector<std::size_t>(start.size(), 0) || count != shape)
+      fail("a partial box in a serial file for", loc, name);
+    write_doubles_shaped(loc, name, data, shape, deflate);
+    return;
+  }
   const std::vector<hsize_t> dims(shape.begin(), shape.end());
   Handle space = simple_space(dims, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                    H5P_DEFAULT, H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
-  const Access a = access_of(loc);
   const std::vector<hsize_t> first(start.begin(), start.end()), extent(count.begin(), count.end());
   hsize_t n = 1;
   for (hsize_t c : extent) n *= c;
@@ -416,8 +450,69 @@ std::vector<std::int64_t> read_int64s_rows(hid_t loc, const std::string& name, s
   return read_integers_rows<std::int64_t>(loc, name, first, count, H5T_NATIVE_INT64);
 }
 
-void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n) {
-  write_dataset(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, data);
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate) {
+  write_doubles_padded(loc, name, data, Rows{0, rows, rows}, mem_cols, file_cols, deflate);
+}
+
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, Rows rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate) {
+  if (mem_cols == file_cols) {
+    write_doubles_rows(loc, name, data, rows, file_cols, deflate);
+    return;
+  }
+  if (mem_cols > file_cols) fail("more columns in memory than in the file for", loc, name);
+  const Access a = access_of(loc);
+  if (a.parallel) deflate = 0;
+  const std::vector<hsize_t> dims{rows.total, file_cols};
+  Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
+  const double zero = 0.0;
+  check(H5Pset_fill_value(dcpl.get(), H5T_NATIVE_DOUBLE, &zero), "cannot set the fill value of", loc, name);
+  check(H5Pset_alloc_time(dcpl.get(), deflate > 0 ? H5D_ALLOC_TIME_INCR : H5D_ALLOC_TIME_EARLY),
+        "cannot set the allocation time of", loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                   dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  if (rows.total == 0 || mem_cols == 0) return;
+  // The first mem_cols columns of this rank's rows, from a dense rows x mem_cols array in memory.
+  const hsize_t start[2] = {rows.first, 0}, count[2] = {rows.count, mem_cols};
+  Handle mspace = simple_space({std::max<hsize_t>(rows.count, 1), mem_cols}, loc, name);
+  if (rows.count > 0) {
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
+          "cannot select columns of", loc, name);
+  } else {
+    H5Sselect_none(space.get());
+    H5Sselect_none(mspace.get());
+  }
+  const double dummy = 0.0;
+  check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, mspace.get(), space.get(), transfer_of(a),
+                 rows.count > 0 ? data : &dummy),
+        "cannot write dataset", loc, name);
+}
+
+void write_column_view(hid_t loc, const std::string& view, const std::string& source_path,
+                       std::size_t rows, std::size_t source_cols, std::size_t first, std::size_t cols) {
+  Handle vspace = simple_space({rows, cols}, loc, view);
+  Handle sspace = simple_space({rows, source_cols}, loc, view);
+  if (rows > 0) {
+    const hsize_t start[2] = {0, first}, count[2] = {rows, cols};
+    check(H5Sselect_hyperslab(sspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
+          "cannot select the source columns of", loc, view);
+  }
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "cannot create properties for", loc, view);
+  if (rows > 0) {
+    check(H5Pset_virtual(dcpl.get(), vspace.get(), ".", source_path.c_str(), sspace.get()),
+          "cannot map the virtual dataset", loc, view);
+  }
+  Handle dset = checked(H5Dcreate2(loc, view.c_str(), H5T_IEEE_F64LE, vspace.get(), H5P_DEFAULT,
+                                   dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, view);
+}
+
+void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n,
+                int deflate) {
+  write_dataset(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, data, deflate);
 }
 
 void write_text(hid_t loc, const std::string& name, const std::string& text) {
@@ -519,11 +614,13 @@ bool has_attribute(hid_t obj, const std::string& name) {
 }
 
 void write_string_attribute(hid_t obj, const std::string& name, const std::string& value) {
-  Handle type = string_type(value.size(), obj, name);
+  // Variable-length UTF-8: h5py and other readers return it as a str, not as bytes.
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
+  check(H5Tset_size(type.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "cannot set the character set for", obj, name);
   Handle space = scalar_space(obj, name);
-  std::string buffer = value;
-  buffer.resize(std::max<std::size_t>(value.size(), 1), '\0');
-  write_attribute(obj, name, type.get(), type.get(), space.get(), buffer.data());
+  const char* text = value.c_str();
+  write_attribute(obj, name, type.get(), type.get(), space.get(), &text);
 }
 
 void write_double_attribute(hid_t obj, const std::string& name, double value) {
@@ -550,6 +647,7 @@ std::string read_string_attribute(hid_t obj, const std::string& name) {
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
     check(H5Tset_size(mtype.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+    check(H5Tset_cset(mtype.get(), H5Tget_cset(type.get())), "cannot set the character set for", obj, name);
     char* text = nullptr;
     check(H5Aread(attr.get(), mtype.get(), &text), "cannot read attribute", obj, name);
     std::string value = text != nullptr ? std::string(text) : std::string();

@@ -143,15 +143,30 @@ void Comm::abort(int code) const {
   std::exit(code);
 }
 
+namespace {
+
+/// Whether an MPI launcher (mpirun/mpiexec of Open MPI or MPICH, Slurm's srun with PMI/PMIx)
+/// started this process: only then is MPI initialised, so that a plain `cairn run` of an MPI
+/// build stays a serial run with no MPI start-up cost.
+bool launched_by_mpi() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+    if (std::getenv(name) != nullptr) return true;
+  return false;
+}
+
+}  // namespace
+
 MpiSession::MpiSession(int* argc, char*** argv) {
+  if (!launched_by_mpi()) return;
   int provided = 0;
   MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
 }
 
 MpiSession::~MpiSession() {
-  int finalised = 0;
+  int initialised = 0, finalised = 0;
+  MPI_Initialized(&initialised);
   MPI_Finalized(&finalised);
-  if (!finalised) MPI_Finalize();
+  if (initialised && !finalised) MPI_Finalize();
 }
 
 #else  // no MPI: one rank

@@ -108,6 +108,13 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   if (comm.parallel()) {
     // Each rank keeps the particles of its box and a window of the grid (docs/parallel.md).
     distribution_ = Distribution<D>(comm, whole_);
+    // Every rank created every particle (the same setup, so tractions and conditions saw them
+    // all); each keeps an equal slab of them and the partition sends each to its owner.
+    const auto n = particles_.n(), rank = static_cast<std::size_t>(comm.rank()),
+               ranks = static_cast<std::size_t>(comm.size());
+    std::vector<std::int32_t> slab(n * (rank + 1) / ranks - n * rank / ranks);
+    std::iota(slab.begin(), slab.end(), static_cast<std::int32_t>(n * rank / ranks));
+    reorder_particles(particles_, slab);
     distribution_.partition(particles_);
     velocity_conditions_.set_comm(comm);
     reach_ = std::max(1, shape_->ghost_layers());
@@ -794,8 +801,10 @@ void Simulation<D>::update_particles(double dt) {
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+    // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
     const Vec<D> x_old = P.position[p];
     P.velocity[p] += e.A_dt;
     P.position[p] += dX;
