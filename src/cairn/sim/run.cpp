@@ -98,9 +98,6 @@ const std::vector<std::string> history_columns = {
 template <int D>
 std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
   std::vector<std::string> columns = history_columns;
-  // Runs on several ranks: the particle imbalance (largest count of a rank / mean count) at
-  // the start of the last step; the other columns are those of a serial run, bit for bit.
-  if (sim.comm().parallel()) columns.push_back("imbalance");
   for (const auto& name : sim.velocity_conditions().names())
     for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
   for (const auto& wall : sim.velocity_conditions().walls())
@@ -112,6 +109,9 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
       for (int k = 0; k < D; ++k)
         columns.push_back(fmt::format("contact_{}_{}_{}", c->field_names()[a], c->field_names()[b], "xyz"[k]));
   }
+  // Runs on several ranks, last: the particle imbalance (largest count of a rank / mean count)
+  // at the start of the last step; the other columns are those of a serial run, bit for bit.
+  if (sim.comm().parallel()) columns.push_back("imbalance");
   return columns;
 }
 
@@ -190,7 +190,7 @@ class Runner {
     checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
-    history_writer_.set_rows(data.history_rows);
+    history_writer_.set_rows(rows_for_columns(data));
     // Every output ends where the checkpoint stands, before the first new step.
     flush_history();
     snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
@@ -313,6 +313,27 @@ class Runner {
       flush_history();
       rows_since_flush_ = 0;
     }
+  }
+
+  /// The checkpoint's history rows in this run's columns: the same columns unless the run that
+  /// wrote it had another number of ranks (the column `imbalance` exists on several ranks only;
+  /// rows restored onto several ranks from a one-rank checkpoint say 1 there).
+  std::vector<std::vector<double>> rows_for_columns(const CheckpointData<D>& data) const {
+    const auto& now = history_writer_.columns();
+    if (data.history_columns == now) return data.history_rows;
+    std::vector<std::vector<double>> rows;
+    for (const auto& stored : data.history_rows) {
+      std::vector<double> row;
+      for (const auto& name : now) {
+        const auto at = std::find(data.history_columns.begin(), data.history_columns.end(), name);
+        if (at != data.history_columns.end() && static_cast<std::size_t>(at - data.history_columns.begin()) < stored.size())
+          row.push_back(stored[static_cast<std::size_t>(at - data.history_columns.begin())]);
+        else if (name == "imbalance")
+          row.push_back(1.0);
+      }
+      rows.push_back(std::move(row));  // a row still short of a column is refused by set_rows
+    }
+    return rows;
   }
 
   void flush_history() {
