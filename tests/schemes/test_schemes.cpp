@@ -308,10 +308,10 @@ TEST(Schemes, DissipatedEnergyAgreesWithTheParticleEnergyBalance) {
       const auto& c = sim.cache();  // the stencils of the step just taken
       for (std::size_t q = 0; q < P.n(); ++q) {
         Vec<2> Sv = Vec<2>::Zero(), Sv_new = Vec<2>::Zero();
-        for (std::size_t t = q * c.stride; t < q * c.stride + c.count[q]; ++t) {
-          Sv += c.weight[t] * sim.nodes().velocity[c.node[t]];
-          Sv_new += c.weight[t] * sim.nodes().velocity_new[c.node[t]];
-        }
+        for_each_entry(c, q, [&](std::int32_t node, double S, const Vec<2>&) {  // any stencil layout
+          Sv += S * sim.nodes().velocity[node];
+          Sv_new += S * sim.nodes().velocity_new[node];
+        });
         const Vec<2> Sa_dt = Sv_new - Sv, dV = P.velocity[q] - V0[q], dX = P.position[q] - X0[q];
         const double flip = P.mass[q] * Sa_dt.dot(Sv + 0.5 * Sa_dt);
         independent += flip - P.mass[q] * dV.dot(dX) / dt;
