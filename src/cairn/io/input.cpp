@@ -1381,6 +1381,9 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
   } else if (r.present("normal_direction")) {
     c.normal_direction = r.reals("normal_direction", static_cast<std::size_t>(dim_), false);
   }
+  c.lr_weights = r.string("lr_weights");
+  c.lr_refine = r.string("lr_refine");
+  c.first_correction = r.string("first_correction");
   c.detection = r.string("detection");
   c.critical_separation = r.real("critical_separation");
   c.touching_tolerance = r.real("touching_tolerance");
@@ -1640,6 +1643,9 @@ std::string config_to_toml(const Config& c) {
     law_lines(ct.law);
     line("normal", toml_string(ct.normal));
     if (!ct.normal_direction.empty()) line("normal_direction", reals_text(ct.normal_direction));
+    line("lr_weights", toml_string(ct.lr_weights));
+    line("lr_refine", toml_string(ct.lr_refine));
+    line("first_correction", toml_string(ct.first_correction));
     line("detection", toml_string(ct.detection));
     line("critical_separation", real_text(ct.critical_separation));
     line("touching_tolerance", real_text(ct.touching_tolerance));

@@ -359,6 +359,20 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("contact", "normal_direction", T::real_array,
                  "specified: the normal, one entry per axis, pointing from the lower-numbered field "
                  "to the higher-numbered one."));
+  k.push_back(Key("contact", "lr_weights", T::string,
+                 "Point weights w_p of the lr and linear fits: shape (each particle's shape-function "
+                 "weight S_ip at the node; a flat interface through a regular particle lattice then "
+                 "gets its exact normal at any offset, docs/contact.md) or uniform (w_p = 1, the "
+                 "seed 004 Appendix).")
+                .by_default("\"shape\"")
+                .choices([] { return std::vector<std::string>{"shape", "uniform"}; }));
+  k.push_back(Key("contact", "lr_refine", T::string,
+                 "Normal of the lr and linear fits: margin (where the two point clouds are linearly "
+                 "separable, the normal of the widest-gap separating plane, the limit the logistic fit "
+                 "approaches; flat interfaces and corners of lattice-filled bodies get their exact "
+                 "normal, docs/contact.md) or none (the fit's own normal, seed 004 Eq. 21).")
+                .by_default("\"margin\"")
+                .choices([] { return std::vector<std::string>{"margin", "none"}; }));
   k.push_back(Key("contact", "detection", T::string,
                  "Contact detection; every method also needs approach, (v_b - v_a).n < 0: lr "
                  "(separation of the point clouds with deformed particle radii, Eq. 22-25), "
@@ -382,6 +396,15 @@ std::vector<KeyDecl> make_declarations() {
                  "26-34); once: only the updated momenta (for comparison).")
                 .by_default("\"twice\"")
                 .choices([] { return std::vector<std::string>{"twice", "once"}; }));
+  k.push_back(Key("contact", "first_correction", T::string,
+                 "How the first correction (on the extrapolated momenta) reaches the particles: "
+                 "impulse (its change at contact interfaces is a contact impulse on the particle "
+                 "velocities, V += S dv, so that they obey the contact; bonded, perfect-law changes "
+                 "stay part of the extrapolation) or extrapolation (seed 004 Eq. 33-34, a = a^a,1 for "
+                 "every law: under FLIP the particles keep the approach velocity the correction "
+                 "removed, which makes frictional sliding chatter; docs/contact.md).")
+                .by_default("\"impulse\"")
+                .choices([] { return std::vector<std::string>{"impulse", "extrapolation"}; }));
   k.push_back(Key("contact", "three_or_more", T::string,
                  "Nodes that see three or more fields: lump (each field against all others lumped, "
                  "Eq. 50) or pairs (the pairs in contact solved together; lumped when three or "

@@ -74,6 +74,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     contact_ = std::make_unique<Contact<D>>(config_, grid_, particles_, small_mass_);
     n_fields_ = contact_->n_fields();
     contact_dv_.assign(n_slots(), Vec<D>::Zero());
+    contact_impulse_.assign(n_slots(), Vec<D>::Zero());
     totals_.mass.assign(grid_.n_nodes(), 0.0);
     totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
     field_offset_.resize(particles_.n());
@@ -200,7 +201,14 @@ void Simulation<D>::step(double dt) {
     // seed 000 Task 3: v+ = m~_k^-1 p+ (FMPM) or v = m~_k^-1 p (XPIC, blends).
     full_mass_velocity(need == FullMass::of_updated ? nodes_.velocity_new : nodes_.velocity,
                        nodes_.velocity_full, k);
-    if (contact_ && contact_->xpic_correction()) subtract_contact_term(nodes_.velocity_full, k);
+    if (contact_ && contact_->xpic_correction()) {
+      subtract_contact_term(nodes_.velocity_full, k);
+      // The dv term comes after the conditions that full_mass_velocity imposed: impose them
+      // again, so that a held node that is also a contact node keeps its condition.
+      if (config_.method.velocity_bc_method != "lumped")
+        impose_conditions(nodes_.velocity_full, need == FullMass::of_updated ? VelocityConditions<D>::When::end
+                                                                              : VelocityConditions<D>::When::start);
+    }
   }
   lap(3);
   update_particles(dt);
@@ -318,10 +326,13 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
     contact_->prepare(particles_, cache_, nodes_.mass);
     // dv^a is zero wherever this step's first correction does not set it (nodes that were
     // contact nodes last step included).
-    for_each_node(n_slots(), [&](std::int32_t i) { contact_dv_[i].setZero(); });
+    for_each_node(n_slots(), [&](std::int32_t i) {
+      contact_dv_[i].setZero();
+      contact_impulse_[i].setZero();
+    });
     if (contact_->corrects_extrapolation())
       contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, step_dt_,
-                        &contact_dv_);
+                        &contact_dv_, contact_->impulse() ? &contact_impulse_ : nullptr);
     const std::int32_t nn = grid_.n_nodes();
     for_each_node(nn, [&](std::int32_t i) {
       double m = 0.0;
@@ -462,10 +473,15 @@ void Simulation<D>::subtract_contact_term(std::vector<Vec<D>>& out, int k) {
   // Multimaterial XPIC(k)/FMPM(k): out -= m~_(k-1)^-1 m dv^a, the (I - S S+a)^(k-1) S dv^a term
   // of seed 004 Eq. 37 / 42-44 in the full-mass form of seed 000 Eq. 5: the sum of A^j dv,
   // j = 0 .. k-2, with A = I - S+a S per field.
+  // With first_correction = "impulse" the particles received the contact part dv_c as an
+  // impulse (V' = V + S dv_c), so the extrapolation correction left is v^a - S+a V' =
+  // dv - S+a S dv_c.
   if (k < 2) return;
+  const bool impulse = contact_->impulse() && contact_->corrects_extrapolation();
+  if (impulse) lumped_projection(contact_impulse_, grid_proj_);
   for_each_node(n_slots(), [&](std::int32_t i) {
-    grid_term_[i] = contact_dv_[i];
-    out[i] -= contact_dv_[i];
+    grid_term_[i] = impulse ? Vec<D>(contact_dv_[i] - grid_proj_[i]) : contact_dv_[i];
+    out[i] -= grid_term_[i];
   });
   for (int j = 1; j < k - 1; ++j) {
     lumped_projection(grid_term_, grid_proj_);
@@ -518,6 +534,7 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
   const std::int32_t* idx = slots();
+  const bool contact_impulse = contact_ && contact_->impulse() && contact_->corrects_extrapolation();
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
     for (std::size_t s = begin; s < end; ++s) {
@@ -528,6 +545,11 @@ void Simulation<D>::update_particles(double dt) {
       if (full) g.Sv_full += S * v_full[i];
     }
     if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
+    if (contact_impulse) {
+      // The first correction's contact change is an impulse on the particle (docs/contact.md):
+      // V' = V + S dv_c, and the update proceeds from V'.
+      for (std::size_t s = begin; s < end; ++s) g.V += cache_.weight[s] * contact_impulse_[idx[s]];
+    }
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
@@ -535,7 +557,7 @@ void Simulation<D>::update_particles(double dt) {
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
     particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
     const Vec<D> x_old = P.position[p];
-    P.velocity[p] += e.A_dt;
+    P.velocity[p] = g.V + e.A_dt;
     P.position[p] += dX;
     if (affine) {
       // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and

@@ -160,6 +160,7 @@ class Simulation {
   std::unique_ptr<Contact<D>> contact_;      ///< multimaterial mode ([contact] mode != none)
   int n_fields_ = 1;
   std::vector<Vec<D>> contact_dv_;           ///< dv^a of the first correction (slots)
+  std::vector<Vec<D>> contact_impulse_;      ///< its non-bonded part, an impulse on the particles (slots)
   NodeField<D> totals_;                      ///< multimaterial: mass and momentum summed over fields
   std::vector<std::int32_t> field_offset_;   ///< multimaterial: field * n_nodes per particle
   double time_ = 0.0;
