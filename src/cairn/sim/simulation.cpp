@@ -11,6 +11,7 @@
 #include "cairn/contact/contact.hpp"
 #include "cairn/materials/plane_stress.hpp"
 #include "cairn/math/tensor.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -55,6 +56,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
+  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   for (const auto& m : materials_) material_density_.push_back(m->density());
   if (config_.thermal.conduction) {
@@ -99,6 +101,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     if (body_force_constant_) body_force_value_ = (*body_force_[0])(Vec<D>::Zero(), Vec<D>::Zero(), 0.0);
     node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
+  check_run_length<D>(*this);
 }
 
 template <int D>
@@ -110,12 +113,16 @@ void Simulation<D>::setup_grid() {
   Vec<D> origin, h;
   IVec<D> n_cells;
   std::array<bool, D> periodic{};
+  std::vector<long long> cells(D);
+  std::vector<bool> wraps(D);
   for (int a = 0; a < D; ++a) {
     origin[a] = g.origin[a];
     h[a] = g.cell_size[a];
-    n_cells[a] = static_cast<int>(std::lround(g.extent[a] / g.cell_size[a]));
-    periodic[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
+    cells[a] = std::llround(g.extent[a] / g.cell_size[a]);
+    periodic[a] = wraps[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
+  check_node_count(config_, cells, wraps, shape_->ghost_layers(), velocity_fields(config_));
+  for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
   grid_ = Grid<D>(origin, n_cells, h, shape_->ghost_layers(), periodic);
 }
 
@@ -553,9 +560,10 @@ void Simulation<D>::update_particles(double dt) {
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
+    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+    // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    particle_scalar_[p] = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
     const Vec<D> x_old = P.position[p];
     P.velocity[p] = g.V + e.A_dt;
     P.position[p] += dX;
@@ -625,7 +633,7 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   if (first_bad >= 0) {
     const auto p = static_cast<std::size_t>(first_bad);
     std::string value;
-    if (what == "det F") value = "det F = " + std::to_string(particles_.deformation_gradient[p].determinant());
+    if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
     else value = what + " is not finite";
     throw SimulationFailure(first_bad, what,
                             "particle " + std::to_string(first_bad) + " (body " +
