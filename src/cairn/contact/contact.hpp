@@ -99,7 +99,7 @@ class Contact {
   bool by_body_ = false;
   bool twice_ = true;
   bool xpic_correction_ = true;
-  bool impulse_ = true;
+  bool impulse_ = false;
   double small_mass_ = 0.0;
   std::int32_t n_nodes_ = 0;
   std::vector<std::string> field_names_;

@@ -197,7 +197,7 @@ struct ContactConfig {
   std::vector<double> normal_direction;  ///< specified: from the first field to the second
   std::string lr_weights = "shape"; ///< lr/linear point weights: shape (S_ip) | uniform (seed 004 Appendix)
   std::string lr_refine = "margin"; ///< lr/linear: margin (max-margin normal when separable) | none
-  std::string first_correction = "impulse";  ///< impulse (contact changes reach the particles) | extrapolation (Eq. 34)
+  std::string first_correction = "extrapolation";  ///< extrapolation (Eq. 34) | impulse (contact changes reach the particles)
   std::string detection = "lr";     ///< lr | velocity | cp | df
   double critical_separation = 0.8; ///< cp: delta_c in cells (seed 004 Eq. 16)
   double touching_tolerance = 1e-3; ///< lr/df: touching when the separation < this many cells

@@ -440,12 +440,13 @@ std::vector<KeyDecl> make_declarations() {
                 .choices([] { return std::vector<std::string>{"twice", "once"}; }));
   k.push_back(Key("contact", "first_correction", T::string,
                  "How the first correction (on the extrapolated momenta) reaches the particles: "
-                 "impulse (its change at contact interfaces is a contact impulse on the particle "
-                 "velocities, V += S dv, so that they obey the contact; bonded, perfect-law changes "
-                 "stay part of the extrapolation) or extrapolation (seed 004 Eq. 33-34, a = a^a,1 for "
-                 "every law: under FLIP the particles keep the approach velocity the correction "
-                 "removed, which makes frictional sliding chatter; docs/contact.md).")
-                .by_default("\"impulse\"")
+                 "extrapolation (seed 004 Eq. 33-34, a = a^a,1 for every law: under FLIP the "
+                 "particles keep the approach velocity the correction removed, which makes frictional "
+                 "sliding chatter) or impulse (its change at contact interfaces is a contact impulse "
+                 "on the particle velocities, V += S dv; bonded, perfect-law changes stay part of the "
+                 "extrapolation; cures the chatter but lets interfaces under sustained compression "
+                 "drift apart, so it is not the default; docs/contact.md).")
+                .by_default("\"extrapolation\"")
                 .choices([] { return std::vector<std::string>{"impulse", "extrapolation"}; }));
   k.push_back(Key("contact", "three_or_more", T::string,
                  "Nodes that see three or more fields: lump (each field against all others lumped, "
