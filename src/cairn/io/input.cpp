@@ -24,6 +24,7 @@
 #include "cairn/io/image.hpp"
 #include "cairn/io/schema.hpp"
 #include "cairn/materials/material.hpp"
+#include "cairn/wls/arrangement.hpp"
 
 namespace cairn {
 
@@ -808,6 +809,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.end_time = r.real("end_time");
   s.cfl = r.real("cfl");
   s.fixed_dt = r.real("dt");
+  s.time_step = r.string("time_step");
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
@@ -859,6 +861,10 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.full_mass_cfl = r.real("full_mass_cfl");
   m.velocity_bc_method = r.string("velocity_bc_method");
   m.time_integration = r.string("time_integration");
+  m.integration = r.string("integration");
+  m.trigger_weight = r.real("trigger_weight");
+  m.surface_distance = r.string("surface_distance");
+  m.spurious_force = r.string("spurious_force");
 }
 
 void Loader::read_constants(const toml::table& root, Config& cfg) {
@@ -1082,6 +1088,11 @@ void Loader::read_bodies(const toml::table& root, Config& cfg) {
     b.velocity = r.expressions("velocity", n);
     if (b.velocity.empty()) b.velocity.assign(n, "0");
     b.displacement = r.expressions("displacement", n);
+    b.arrangement = r.string("arrangement");
+    if (b.arrangement == "radial" && !wls::radial_arrangement_supported(b.shape.kind))
+      r.fail("arrangement", r.given("arrangement"),
+             "cartesian for a " + b.shape.kind + " (radial needs a circle, annulus or sphere shape)",
+             toml_string(b.arrangement));
     b.where = {file_, line_of(t)};
     cfg.bodies.push_back(std::move(b));
   }
@@ -1494,6 +1505,7 @@ std::string config_to_toml(const Config& c) {
   line("end_time", real_text(s.end_time));
   line("cfl", real_text(s.cfl));
   line("dt", real_text(s.fixed_dt));
+  line("time_step", toml_string(s.time_step));
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
@@ -1518,6 +1530,10 @@ std::string config_to_toml(const Config& c) {
   line("full_mass_cfl", real_text(m.full_mass_cfl));
   line("velocity_bc_method", toml_string(m.velocity_bc_method));
   line("time_integration", toml_string(m.time_integration));
+  line("integration", toml_string(m.integration));
+  line("trigger_weight", real_text(m.trigger_weight));
+  line("surface_distance", toml_string(m.surface_distance));
+  line("spurious_force", toml_string(m.spurious_force));
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";
@@ -1554,6 +1570,7 @@ std::string config_to_toml(const Config& c) {
     line("particles_per_cell", array_text(b.particles_per_cell, [](int n) { return fmt::format("{}", n); }));
     line("velocity", array_text(b.velocity, expression_text));
     if (!b.displacement.empty()) line("displacement", array_text(b.displacement, expression_text));
+    line("arrangement", toml_string(b.arrangement));
   }
 
   o += "\n[boundary]\n";

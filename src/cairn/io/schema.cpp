@@ -85,6 +85,12 @@ std::vector<KeyDecl> make_declarations() {
                  "Fixed time step; 0 = use the CFL rule.")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("simulation", "time_step", T::string,
+                 "CFL rule of the time step (without simulation.dt): adaptive = cfl h_min / "
+                 "(c_max + max|v|) every step (seed 001 Eq. 34); nominal = cfl h_min / c_max with "
+                 "the wave speeds of the undeformed materials, fixed for the run (Eq. 35).")
+                .by_default("\"adaptive\"")
+                .choices([] { return std::vector<std::string>{"adaptive", "nominal"}; }));
   k.push_back(Key("simulation", "max_steps", T::integer,
                  "Stop after this many steps; 0 = no limit.")
                 .by_default("0")
@@ -174,6 +180,31 @@ std::vector<KeyDecl> make_declarations() {
                  "Sec. 4.7).")
                 .by_default("\"forward_euler\"")
                 .choices([] { return std::vector<std::string>{"forward_euler", "central_difference"}; }));
+  k.push_back(Key("method", "integration", T::string,
+                 "Where the weak form is integrated: mpm = at the particles (every shape family and "
+                 "update above); wls = the weighted-least-squares PIC method of seed 001 (node "
+                 "fits, cut grid cells with one centroid point per region, central differences; "
+                 "shape, update, order and stress_update are then unused; docs/wls.md).")
+                .by_default("\"mpm\"")
+                .choices([] { return std::vector<std::string>{"mpm", "wls"}; }));
+  k.push_back(Key("method", "trigger_weight", T::real,
+                 "WLS trigger weight TW (seed 001 Sec. 3.5): a node whose particles all have a "
+                 "wide weight W below TW is spurious (constant fit, averaged internal force).")
+                .by_default("0.12")
+                .min(above_zero)
+                .max(1.0));
+  k.push_back(Key("method", "surface_distance", T::string,
+                 "WLS signed distance of near-surface nodes (seed 001 Sec. 3.3): projection of "
+                 "x_surf - x_i on the unit normal (the text) or distance |x_surf - x_i| with the "
+                 "normal's sign (Eq. 17 as printed).")
+                .by_default("\"distance\"")
+                .choices([] { return std::vector<std::string>{"projection", "distance"}; }));
+  k.push_back(Key("method", "spurious_force", T::string,
+                 "WLS internal force of spurious nodes (seed 001 Sec. 4.5): per_mass = the node "
+                 "mass times the mean f_int / m of its well-conditioned neighbours; force = the "
+                 "mean f_int of those neighbours (docs/wls.md).")
+                .by_default("\"per_mass\"")
+                .choices([] { return std::vector<std::string>{"per_mass", "force"}; }));
 
   // [[material]] (the model's own keys come from material_model_info())
   k.push_back(Key("material", "name", T::string,
@@ -216,6 +247,14 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("body", "displacement", T::expression_array,
                  "Initial displacement field, entries as for velocity (F is set from its "
                  "gradient); default none."));
+
+  k.push_back(Key("body", "arrangement", T::string,
+                 "Particle placement: cartesian = the lattice of particles_per_cell; radial = "
+                 "concentric rings (2D) or shells (3D) about h / particles_per_cell apart, for "
+                 "circle, annulus and sphere shapes (seed 001 Fig. 4b). Under method.integration = "
+                 "\"wls\" every body also gets zero-volume surface particles.")
+                .by_default("\"cartesian\"")
+                .choices([] { return std::vector<std::string>{"cartesian", "radial"}; }));
 
   // [[body]] shape kinds
   k.push_back(Key("body.shape.box", "min", T::real_array,

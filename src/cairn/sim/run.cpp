@@ -13,6 +13,7 @@
 #include "cairn/io/snapshot.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/integrator.hpp"
 
 namespace cairn {
 namespace {
@@ -73,6 +74,8 @@ class Runner {
     history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
     checkpoint_.interval = out.checkpoint_every;
     std::filesystem::create_directories(dir_);
+    // WLS: the integration regions (cut cells) beside every particle snapshot, wls_cells.xdmf.
+    if (sim_.wls()) cells_ = std::make_unique<SnapshotWriter<D>>(dir_, "wls_cells");
   }
 
   void restore(const CheckpointData<D>& data) {
@@ -91,6 +94,14 @@ class Runner {
     history_writer_.set_rows(data.history_rows);
     snapshots_.set_entries(data.snapshot_entries);
     snapshots_.set_next_index(data.snapshot_next_index);
+    if (cells_) {
+      // The region files are written in step with the particle files: same index, other stem.
+      auto entries = data.snapshot_entries;
+      for (auto& [time, file] : entries)
+        if (file.rfind("particles-", 0) == 0) file = "wls_cells-" + file.substr(10);
+      cells_->set_entries(entries);
+      cells_->set_next_index(data.snapshot_next_index);
+    }
     restarted_ = true;
   }
 
@@ -201,6 +212,8 @@ class Runner {
     }
     else
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    // The regions of the last step (none before the first step).
+    if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
 
   void write_checkpoint_file() {
@@ -279,6 +292,7 @@ class Runner {
   Schedule history_, snapshot_, checkpoint_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
+  std::unique_ptr<SnapshotWriter<D>> cells_;  ///< WLS integration regions
   double initial_energy_ = 0.0;
   double last_dt_ = 0.0;
   int checkpoint_index_ = 0;
