@@ -216,6 +216,8 @@ struct OutputConfig {
   bool snapshots = true;        ///< write HDF5/XDMF particle snapshots
   bool grid_snapshots = false;  ///< also write node fields
   bool checkpoints = true;
+  /// D expressions of the exact displacement u(X, t) (manufactured solutions); empty = none.
+  std::vector<std::string> exact_displacement;
 };
 
 struct Config {

@@ -1357,6 +1357,7 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.snapshots = r.boolean("snapshots");
   o.grid_snapshots = r.boolean("grid_snapshots");
   o.checkpoints = r.boolean("checkpoints");
+  o.exact_displacement = r.expressions("exact_displacement", static_cast<std::size_t>(dim_));
 }
 
 void Loader::read_contact(const toml::table& root, Config& cfg) {
@@ -1679,6 +1680,8 @@ std::string config_to_toml(const Config& c) {
   line("snapshots", boolean(out.snapshots));
   line("grid_snapshots", boolean(out.grid_snapshots));
   line("checkpoints", boolean(out.checkpoints));
+  if (!out.exact_displacement.empty())
+    line("exact_displacement", array_text(out.exact_displacement, expression_text));
   return o;
 }
 

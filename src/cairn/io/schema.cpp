@@ -545,6 +545,12 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("output", "checkpoints", T::boolean,
                  "Write checkpoints for `cairn restart`.")
                 .by_default("true"));
+  k.push_back(Key("output", "exact_displacement", T::expression_array,
+                 "Exact displacement u(X, t) of a manufactured solution, one expression per axis "
+                 "in X, Y, Z, t and [constants]: history.csv gets displacement_error, the largest "
+                 "|x - X - u(X, t)| over the particles at the row's time, and "
+                 "displacement_error_max, the largest over every step so far (seed 001 Eq. 38); "
+                 "default none."));
   return k;
 }
 

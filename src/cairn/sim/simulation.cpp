@@ -108,7 +108,15 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     o.trigger_weight = config_.method.trigger_weight;
     o.projected_distance = config_.method.surface_distance == "projection";
     o.average_per_mass = config_.method.spurious_force == "per_mass";
-    for (int f = 0; f < 2 * D; ++f) o.symmetry[f] = config_.boundary.face[f] == FaceCondition::symmetry;
+    // A symmetry face is a mirror plane of the body when the body reaches it at the start
+    // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
+    for (int f = 0; f < 2 * D; ++f) {
+      if (config_.boundary.face[f] != FaceCondition::symmetry) continue;
+      const int a = f / 2;
+      const double plane = f % 2 ? grid_.extent_max()[a] : grid_.origin()[a];
+      for (std::size_t p = 0; p < particles_.n() && !o.mirror[f]; ++p)
+        o.mirror[f] = std::abs(particles_.position[p][a] - plane) < 0.5 * grid_.cell_size()[a];
+    }
     o.thickness = config_.simulation.thickness;
     wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
   }

@@ -232,7 +232,7 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     bool on_symmetry[D];
     double mirror = 1.0;
     for (int a = 0; a < D; ++a) {
-      on_symmetry[a] = (j[a] == 0 && options_.symmetry[2 * a]) || (j[a] == n_cells_[a] && options_.symmetry[2 * a + 1]);
+      on_symmetry[a] = (j[a] == 0 && options_.mirror[2 * a]) || (j[a] == n_cells_[a] && options_.mirror[2 * a + 1]);
       if (on_symmetry[a]) mirror *= 2.0;
     }
     beta_[i] *= mirror;

@@ -46,7 +46,9 @@ struct Options {
   /// Spurious-node internal force (Sec. 3.5, 4.5): true = mean of the neighbours' internal
   /// force per unit mass, times the node's mass; false = mean of the neighbours' internal force.
   bool average_per_mass = true;
-  std::array<bool, 6> symmetry{};  ///< face 2*axis + side is a symmetry plane
+  /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches): node
+  /// flags count the mirror image and surface positions of nodes on it lie in it.
+  std::array<bool, 6> mirror{};
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
 };
 
