@@ -494,6 +494,39 @@ TEST(WlsIntegration, NodeFitsReproduceLinearVelocityFields) {
   check_linear_velocity<3>("sphere");
 }
 
+template <int D>
+void check_particle_gradient(const std::string& velocity_gradient) {
+  // One step from an unstressed body moving with v = v0 + A x: the forces vanish, v+ is the
+  // node fit, and particles away from the surface get grad V = A exactly, by either rule.
+  Config c = wls_config(D, "circle", 0.05);
+  c.method.velocity_gradient = velocity_gradient;
+  const double entries[9] = {0.3, -0.7, 0.2, 0.5, 0.1, -0.4, 0.6, -0.2, 0.9};
+  Eigen::Matrix<double, D, D> A;
+  for (int a = 0; a < D; ++a) {
+    std::string e = "0.1";
+    for (int b = 0; b < D; ++b) {
+      A(a, b) = entries[3 * a + b];
+      e += " + " + std::to_string(A(a, b)) + " * (" + std::string(1, "XYZ"[b]) + " - 0.5)";
+    }
+    c.bodies[0].velocity.push_back(e);
+  }
+  Simulation<D> sim(c);
+  sim.step(1e-9);
+  int checked = 0;
+  for (std::size_t p = 0; p < sim.particles().n(); ++p) {
+    if ((sim.particles().position[p] - Vec<D>::Constant(0.5)).norm() > 0.3 - 2.5 * 0.05) continue;
+    EXPECT_NEAR((sim.particles().velocity_gradient[p].template topLeftCorner<D, D>() - A).norm(), 0.0, 1e-9) << p;
+    ++checked;
+  }
+  EXPECT_GT(checked, 50);
+}
+
+TEST(WlsIntegration, ParticleVelocityGradientsReproduceLinearFields) {
+  check_particle_gradient<2>("quadrature");
+  check_particle_gradient<2>("narrow");
+  check_particle_gradient<3>("quadrature");
+}
+
 TEST(WlsIntegration, RigidTranslationStaysUndeformed) {
   Config c = wls_config(2, "circle", 0.05);
   c.bodies[0].velocity = {"0.4", "-0.3"};

@@ -65,6 +65,7 @@ struct MethodConfig {
   double trigger_weight = 0.12;                  ///< WLS TW (seed 001 Sec. 3.5)
   std::string surface_distance = "distance";     ///< WLS near-surface distance: projection | distance
   std::string spurious_force = "per_mass";       ///< WLS spurious-node internal force: per_mass | force
+  std::string velocity_gradient = "quadrature";  ///< WLS particle velocity gradient: quadrature | narrow
 };
 
 /// A material's parameters after validation against the model's declared keys (defaults filled).

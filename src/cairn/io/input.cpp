@@ -865,6 +865,7 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.trigger_weight = r.real("trigger_weight");
   m.surface_distance = r.string("surface_distance");
   m.spurious_force = r.string("spurious_force");
+  m.velocity_gradient = r.string("velocity_gradient");
 }
 
 void Loader::read_constants(const toml::table& root, Config& cfg) {
@@ -1535,6 +1536,7 @@ std::string config_to_toml(const Config& c) {
   line("trigger_weight", real_text(m.trigger_weight));
   line("surface_distance", toml_string(m.surface_distance));
   line("spurious_force", toml_string(m.spurious_force));
+  line("velocity_gradient", toml_string(m.velocity_gradient));
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";

@@ -205,6 +205,13 @@ std::vector<KeyDecl> make_declarations() {
                  "mean f_int of those neighbours (docs/wls.md).")
                 .by_default("\"per_mass\"")
                 .choices([] { return std::vector<std::string>{"per_mass", "force"}; }));
+  k.push_back(Key("method", "velocity_gradient", T::string,
+                 "WLS particle velocity gradient: quadrature = the gradients at the integration "
+                 "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
+                 "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed, "
+                 "unstable at free surfaces in our runs; docs/wls.md).")
+                .by_default("\"quadrature\"")
+                .choices([] { return std::vector<std::string>{"quadrature", "narrow"}; }));
 
   // [[material]] (the model's own keys come from material_model_info())
   k.push_back(Key("material", "name", T::string,

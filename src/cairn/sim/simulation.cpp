@@ -108,6 +108,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     o.trigger_weight = config_.method.trigger_weight;
     o.projected_distance = config_.method.surface_distance == "projection";
     o.average_per_mass = config_.method.spurious_force == "per_mass";
+    o.quadrature_gradient = config_.method.velocity_gradient == "quadrature";
     // A symmetry face is a mirror plane of the body when the body reaches it at the start
     // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
     for (int f = 0; f < 2 * D; ++f) {
@@ -301,7 +302,7 @@ void Simulation<D>::wls_step(double dt) {
   lap(1);
   update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)
   lap(2);
-  wls_->move_particles(nodes_, particles_, dt);  // Eq. 27-29
+  wls_->move_particles(grid_, nodes_, particles_, dt);  // Eq. 27-29 (or the quadrature gradient)
   lap(4);
   // Eq. 30: F <- (I + grad V dt) F, then the material.
   const auto n = static_cast<std::int64_t>(particles_.n());

@@ -412,36 +412,43 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
 }
 
 template <int D>
+template <class Fn>
+void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const {
+  const Vec<D> inv_h = h_.cwiseInverse();
+  const IVec<D> j = grid.multi_index(i);
+  for (int k = 0; k < (1 << D); ++k) {  // node i is corner k of the cell j - bits(k)
+    IVec<D> cell = j;
+    bool inside = true;
+    for (int a = 0; a < D; ++a) {
+      cell[a] -= (k >> a) & 1;
+      inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
+    }
+    if (!inside) continue;
+    std::int64_t c = 0;
+    for (int a = D - 1; a >= 0; --a) c = c * n_cells_[a] + cell[a];
+    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
+    for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) {
+      double S;
+      Vec<D> G;
+      corner_shape<D>(k, (regions_[r].centroid - lo).cwiseProduct(inv_h), inv_h, S, G);
+      fn(r, regions_[r], S, G);
+    }
+  }
+}
+
+template <int D>
 void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
                               std::vector<Vec<D>>* node_body_force) {
   const std::int32_t n_nodes = grid.n_nodes();
-  const Vec<D> inv_h = h_.cwiseInverse();
   // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
   for_each_node(n_nodes, [&](std::int32_t i) {
     double m = 0.0;
     Vec<D> fe = Vec<D>::Zero(), fi = Vec<D>::Zero();
-    const IVec<D> j = grid.multi_index(i);
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> cell = j;
-      bool inside = true;
-      for (int a = 0; a < D; ++a) {
-        cell[a] -= (k >> a) & 1;
-        inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
-      }
-      if (!inside) continue;
-      std::int64_t c = 0;
-      for (int a = D - 1; a >= 0; --a) c = c * n_cells_[a] + cell[a];
-      const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
-      for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) {
-        const Region<D>& q = regions_[r];
-        double S;
-        Vec<D> G;
-        corner_shape<D>(k, (q.centroid - lo).cwiseProduct(inv_h), inv_h, S, G);
-        m += S * q.density * q.volume;                 // Eq. 22
-        fe += S * q.volume * q.force_density;          // Eq. 23
-        fi -= q.volume * (q.stress * G);               // Eq. 24 (with sigma_q; Eq. 3's sign)
-      }
-    }
+    for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>& G) {
+      m += S * q.density * q.volume;         // Eq. 22
+      fe += S * q.volume * q.force_density;  // Eq. 23
+      fi -= q.volume * (q.stress * G);       // Eq. 24 (with sigma_q; Eq. 3's sign)
+    });
     nodes.mass[i] = m;
     nodes.momentum[i] = m * velocity_[i];
     internal_force_[i] = fi;
@@ -483,22 +490,80 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
 }
 
 template <int D>
-void Integrator<D>::move_particles(const NodeField<D>& nodes, Particles<D>& particles, double dt) const {
+void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
+  // (the strain rate the internal force of Eq. 24 is the power conjugate of) ...
+  const auto n_regions = static_cast<std::int64_t>(regions_.size());
+  region_gradient_.resize(regions_.size());
+  const Vec<D> inv_h = h_.cwiseInverse();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t r = 0; r < n_regions; ++r) {
+    const Region<D>& q = regions_[r];
+    IVec<D> cell;
+    std::int64_t c = q.cell;
+    for (int a = 0; a < D; ++a) {
+      cell[a] = static_cast<int>(c % n_cells_[a]);
+      c /= n_cells_[a];
+    }
+    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
+    const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) {
+      IVec<D> j = cell;
+      for (int a = 0; a < D; ++a) j[a] += (k >> a) & 1;
+      double S;
+      Vec<D> G;
+      corner_shape<D>(k, local, inv_h, S, G);
+      L += v_new[grid.node_index(j)] * G.transpose();
+    }
+    region_gradient_[r] = L;
+  }
+  // ... and its S V-weighted mean over the integration points around each node.
+  const std::int32_t n_nodes = grid.n_nodes();
+  node_gradient_.resize(n_nodes);
+  node_gradient_weight_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    Eigen::Matrix<double, D, D> sum = Eigen::Matrix<double, D, D>::Zero();
+    double weight = 0.0;
+    for_each_region_of_node(grid, i, [&](std::int32_t r, const Region<D>& q, double S, const Vec<D>&) {
+      sum += S * q.volume * region_gradient_[r];
+      weight += S * q.volume;
+    });
+    node_gradient_[i] = weight > 0.0 ? Eigen::Matrix<double, D, D>(sum / weight) : sum;
+    node_gradient_weight_[i] = weight;
+  });
+}
+
+template <int D>
+void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles,
+                                   double dt) {
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
+  const bool from_quadrature = options_.quadrature_gradient;
+  if (from_quadrature) quadrature_gradients(grid, v_new);
   gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
     Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
-    Mat3 L = Mat3::Zero();
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    double weight = 0.0;
     for (std::size_t s = begin; s < end; ++s) {
       const std::int32_t i = cache_.node[s];
       const double S = shape_[s];
       dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
       vx += S * v_new[i];           // Eq. 28
-      L.template topLeftCorner<D, D>() += v_new[i] * cache_.gradient[s].transpose();  // Eq. 29
+      if (!from_quadrature) {
+        L += v_new[i] * cache_.gradient[s].transpose();  // Eq. 29
+      } else if (node_gradient_weight_[i] > 0.0) {
+        // S-interpolated node means of the integration points' gradients (docs/wls.md), over
+        // the nodes that have integration points around them.
+        L += S * node_gradient_[i];
+        weight += S;
+      }
     }
+    if (from_quadrature && weight > 0.0) L /= weight;
     particles.velocity[p] += dv;
     particles.position[p] += vx * dt;
-    particles.velocity_gradient[p] = L;
+    particles.velocity_gradient[p].setZero();
+    particles.velocity_gradient[p].template topLeftCorner<D, D>() = L;
   });
 }
 

@@ -49,6 +49,10 @@ struct Options {
   /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches): node
   /// flags count the mirror image and surface positions of nodes on it lie in it.
   std::array<bool, 6> mirror{};
+  /// Particle velocity gradient: true = from the integration points (sum_k v+_k (x) G_kq at each
+  /// region, S V-averaged to the nodes, S-interpolated to the particle; docs/wls.md); false =
+  /// Eq. 29 as printed (sum_i v+_i (x) G_ip), unstable at free surfaces in our runs.
+  bool quadrature_gradient = true;
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
 };
 
@@ -80,8 +84,10 @@ class Integrator {
                std::vector<Vec<D>>* node_body_force);
 
   /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
-  /// x += S v+ dt, grad V = sum v+ (x) G into particles.velocity_gradient.
-  void move_particles(const NodeField<D>& nodes, Particles<D>& particles, double dt) const;
+  /// x += S v+ dt, and the velocity gradient into particles.velocity_gradient: Eq. 29
+  /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
+  /// integration points' gradients.
+  void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);
 
   // ---- inspection (tests, snapshots) ----------------------------------------------------------
   [[nodiscard]] const std::vector<double>& signed_distance() const { return distance_; }
@@ -110,6 +116,10 @@ class Integrator {
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
   void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force);
+  /// fn(region index, region, S_iq, G_iq) for every region in the cells node i is a corner of.
+  template <class Fn>
+  void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;
+  void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
 
   Options options_;
   Vec<D> h_;
@@ -138,6 +148,9 @@ class Integrator {
   // cells
   std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_
   std::vector<Region<D>> regions_;
+  std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
+  std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
+  std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
 };
 
 /// The integration regions as points for a snapshot (ParaView): position = centroid, volume0 =
