@@ -37,12 +37,17 @@ struct SimulationConfig {
   long long max_steps = 0;  ///< 0: no limit
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
+  double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
+  double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
+  std::string body_overlap = "error";  ///< bodies sharing space: error | warn
+  SourceLocation where;     ///< the [simulation] table (end_time's line when given)
 };
 
 struct GridConfig {
   std::vector<double> origin;     ///< D values
   std::vector<double> extent;     ///< D values: domain size
   std::vector<double> cell_size;  ///< D values (one given value is repeated)
+  SourceLocation where;           ///< of grid.cell_size
 };
 
 struct MethodConfig {
@@ -109,6 +114,7 @@ struct BodyConfig {
   std::vector<std::string> velocity;    ///< D expressions in X,Y,Z (numbers are expressions too)
   std::vector<std::string> displacement;  ///< D expressions in X,Y,Z; empty = none
   std::string arrangement = "cartesian";  ///< cartesian lattice | radial (seed 001 Fig. 4b)
+  bool clip = false;  ///< keep the part of the shape inside the grid; false: past the grid is an error
   SourceLocation where;
 };
 
@@ -238,6 +244,9 @@ struct Config {
   ThermalConfig thermal;
   ContactConfig contact;
   OutputConfig output;
+  /// Values that are valid but suspicious (e.g. a density of 1e308), one message each with file,
+  /// line and key; the CLI prints them.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace cairn

@@ -100,9 +100,28 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("1.0")
                 .min(above_zero));
   k.push_back(Key("simulation", "threads", T::integer,
-                 "OpenMP threads; 0 = the OpenMP default.")
+                 "OpenMP threads, at most 1024; 0 = the command line's -t, else the OpenMP "
+                 "default (OMP_NUM_THREADS or all cores).")
                 .by_default("0")
-                .min(0));
+                .min(0)
+                .max(1024));
+  k.push_back(Key("simulation", "memory_limit", T::real,
+                 "GiB of memory the setup may need (grid nodes, particles, transfer caches, "
+                 "estimated before anything is allocated); 0 = the machine's memory (its cgroup "
+                 "limit when lower). A larger estimate is refused, naming the keys that drive it.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("simulation", "max_estimated_steps", T::real,
+                 "Refuse a run whose end_time / first time step exceeds this (a run that would "
+                 "never end), naming the material that sets the step; 0 = no check. Not checked "
+                 "when max_steps > 0.")
+                .by_default("1e8")
+                .min(0.0));
+  k.push_back(Key("simulation", "body_overlap", T::string,
+                 "Bodies whose shapes share space (their mass counts twice there): error refuses "
+                 "the input, warn prints a warning naming both and runs.")
+                .by_default("\"error\"")
+                .choices([] { return std::vector<std::string>{"error", "warn"}; }));
 
   // [grid]
   k.push_back(Key("grid", "origin", T::real_array,
@@ -250,10 +269,14 @@ std::vector<KeyDecl> make_declarations() {
                 .max(16));
   k.push_back(Key("body", "velocity", T::expression_array,
                  "Initial velocity, one entry per axis: numbers or expressions in X, Y, Z "
-                 "(reference position) and [constants]; default zeros."));
+                 "(reference position) and [constants], evaluated once (no t); default zeros."));
   k.push_back(Key("body", "displacement", T::expression_array,
                  "Initial displacement field, entries as for velocity (F is set from its "
                  "gradient); default none."));
+  k.push_back(Key("body", "clip", T::boolean,
+                 "Keep only the part of the shape inside the grid; false: a shape reaching past "
+                 "the grid (by half a particle spacing or more) is an error.")
+                .by_default("false"));
 
   k.push_back(Key("body", "arrangement", T::string,
                  "Particle placement: cartesian = the lattice of particles_per_cell; radial = "
@@ -836,7 +859,20 @@ std::string markdown_text() {
       "- `D` is `simulation.dimension`; `real[D]` is an array with one number per axis.\n"
       "- Integers are accepted wherever a real is expected.\n"
       "- `expr[D]` entries are numbers or expression strings such as `\"A*sin(2*_pi*X)\"`; "
-      "they may use the names of `[constants]`. An empty string is an error.\n"
+      "they may use the names of `[constants]`. An empty string is an error. Each is checked "
+      "when the input is read: one expression (a `,` outside a function's arguments, as in "
+      "`\"-9,81\"`, is an error), no assignment (`=`, `+=`, ...), only the variables its key "
+      "allows: initial values (`[[body]]` velocity and displacement) the positions `x y z X Y Z` "
+      "up to the dimension but not `t`; time functions (traction scale, `[[velocity]]` and "
+      "`[[wall]]` velocity and gradient) only `t`; the body force both.\n"
+      "- A number beyond 1e30 in magnitude (or nonzero below 1e-30) is accepted with a warning: "
+      "no unit system needs it, and energies or stresses may overflow.\n"
+      "- Before anything is allocated, the grid's node count is checked against the 32-bit node "
+      "index (at most 1e9 cells per axis), and the memory of grid, particles and transfer caches "
+      "is estimated against `simulation.memory_limit`; a run whose `end_time` / first time step "
+      "exceeds `simulation.max_estimated_steps` is refused naming what sets the step. A body must "
+      "lie inside the grid (`clip = true` keeps the part inside) and may not share space with "
+      "another (`simulation.body_overlap`). docs/robustness.md lists every guard.\n"
       "- Any key can be overridden on the command line: `cairn run case.toml --set "
       "method.order=4 --set material[0].density=1100`. The value is read as a TOML value "
       "(`--set grid.origin=[0,0]`), or as a plain string when it is not one "
@@ -844,6 +880,9 @@ std::string markdown_text() {
       "their index from 0: `material.0.density` or `material[0].density`.\n"
       "- `cairn check case.toml` validates an input and prints it with every default filled "
       "in.\n"
+      "- Exit codes of `cairn`: 0 success; 2 bad input (this page's errors, a bad command line, "
+      "a damaged or edited checkpoint); 3 the simulation failed; 1 any other error (a full disk "
+      "says \"no space left on device\").\n"
       "\n"
       "Sections: ";
   std::vector<std::string> links;

@@ -54,6 +54,12 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
       std::array<std::array<double, max_width>, D> w{}, dw{};
       IVec<D> first;
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
+        bad_t = std::min<std::int64_t>(bad_t, p);
+        cache.cell[p] = IVec<D>::Zero();
+        cache.count[p] = 0;
+        continue;
+      }
       IVec<D> cell;
       for (int a = 0; a < D; ++a) {
         cell[a] = static_cast<int>(std::floor(xi[a]));
@@ -113,7 +119,7 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
   if (first_bad != INT64_MAX) {
     const Vec<D>& x = particles.position[first_bad];
     std::string where;
-    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + failure_number(x[a]);
     throw SimulationFailure(first_bad, "position",
                             "particle " + std::to_string(first_bad) + " left the grid at (" +
                                 where + "): its stencil reaches beyond the ghost nodes");

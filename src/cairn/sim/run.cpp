@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
 #include "cairn/bc/expression.hpp"
 
@@ -15,6 +16,7 @@
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/integrator.hpp"
@@ -89,7 +91,21 @@ class Runner {
         exact_.push_back(std::make_unique<ExpressionVector<D>>(out.exact_displacement, config_.constants));
   }
 
+  /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
+  /// computed so far in history.csv.
+  ~Runner() {
+    if (std::uncaught_exceptions() == 0) return;
+    try {
+      history_writer_.flush();
+    } catch (const std::exception&) {
+      // the exception in flight says what went wrong
+    }
+  }
+  Runner(const Runner&) = delete;
+  Runner& operator=(const Runner&) = delete;
+
   void restore(const CheckpointData<D>& data) {
+    check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
     sim_.particles() = data.particles;
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
@@ -135,7 +151,7 @@ class Runner {
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
-        fail(f);
+        fail(f, dt);
       }
       last_dt_ = dt;
       measure_error();
@@ -280,12 +296,13 @@ class Runner {
     write_checkpoint<D>(last_checkpoint_, data);
   }
 
-  [[noreturn]] void fail(const SimulationFailure& f) {
+  /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
+  [[noreturn]] void fail(const SimulationFailure& f, double dt) {
     history_writer_.flush();
     std::string saved;
     try {
       SnapshotWriter<D> failure(dir_, "failure");
-      failure.write(sim_.particles(), sim_.time(), sim_.step_count());
+      failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
       saved = "; the failed state could not be written";

@@ -11,6 +11,7 @@
 #include "cairn/contact/contact.hpp"
 #include "cairn/materials/plane_stress.hpp"
 #include "cairn/math/tensor.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/integrator.hpp"
@@ -56,6 +57,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
+  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   for (const auto& m : materials_) material_density_.push_back(m->density());
   if (config_.thermal.conduction) {
@@ -131,6 +133,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     if (body_force_constant_) body_force_value_ = (*body_force_[0])(Vec<D>::Zero(), Vec<D>::Zero(), 0.0);
     node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
+  check_run_length<D>(*this);
   if (wls_) {
     // The initial node fields and integration regions, so that output at t = 0 shows them.
     wls_->build_stencils(grid_, particles_);
@@ -149,14 +152,18 @@ void Simulation<D>::setup_grid() {
   Vec<D> origin, h;
   IVec<D> n_cells;
   std::array<bool, D> periodic{};
+  std::vector<long long> cells(D);
+  std::vector<bool> wraps(D);
   for (int a = 0; a < D; ++a) {
     origin[a] = g.origin[a];
     h[a] = g.cell_size[a];
-    n_cells[a] = static_cast<int>(std::lround(g.extent[a] / g.cell_size[a]));
-    periodic[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
+    cells[a] = std::llround(g.extent[a] / g.cell_size[a]);
+    periodic[a] = wraps[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
   // WLS's wide weight reaches one node beyond a particle's nearest node.
   const int ghost = std::max(shape_->ghost_layers(), config_.method.integration == "wls" ? 1 : 0);
+  check_node_count(config_, cells, wraps, ghost, velocity_fields(config_));
+  for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
   grid_ = Grid<D>(origin, n_cells, h, ghost, periodic);
 }
 
@@ -711,7 +718,7 @@ template <int D>
 void Simulation<D>::particle_failure(std::int64_t first_bad, const std::string& what) const {
   const auto p = static_cast<std::size_t>(first_bad);
   std::string value;
-  if (what == "det F") value = "det F = " + std::to_string(particles_.deformation_gradient[p].determinant());
+  if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
   else value = what + " is not finite";
   throw SimulationFailure(first_bad, what,
                           "particle " + std::to_string(first_bad) + " (body " +
