@@ -974,6 +974,7 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.surface_distance = r.string("surface_distance");
   m.spurious_force = r.string("spurious_force");
   m.velocity_gradient = r.string("velocity_gradient");
+  m.filter_acceleration = r.boolean("filter_acceleration");
 }
 
 void Loader::read_constants(const toml::table& root, Config& cfg) {
@@ -1653,6 +1654,7 @@ std::string config_to_toml(const Config& c) {
   line("surface_distance", toml_string(m.surface_distance));
   line("spurious_force", toml_string(m.spurious_force));
   line("velocity_gradient", toml_string(m.velocity_gradient));
+  line("filter_acceleration", m.filter_acceleration ? "true" : "false");
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";

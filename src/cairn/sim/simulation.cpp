@@ -308,6 +308,10 @@ void Simulation<D>::wls_step(double dt) {
   velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
   lap(1);
   update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)
+  if (config_.method.filter_acceleration) {
+    wls_->filter_acceleration(grid_, nodes_);
+    impose_conditions(nodes_.velocity_new, VelocityConditions<D>::When::end);
+  }
   lap(2);
   wls_->move_particles(grid_, nodes_, particles_, dt);  // Eq. 27-29 (or the quadrature gradient)
   lap(4);

@@ -490,6 +490,47 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
 }
 
 template <int D>
+void Integrator<D>::filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes) {
+  // dv_i = v+_i - v_i = a_i dt replaced by the planar least-squares fit (Eq. 7-12 on the grid)
+  // over the node and its 3^D - 1 neighbours that carry mass, weighted by W(x_j - x_i) m_j:
+  // linear acceleration fields pass unchanged, the node-to-node zig-zag a single node's small
+  // cut-cell mass and force produce does not (docs/wls.md).
+  const std::int32_t n_nodes = grid.n_nodes();
+  filtered_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    filtered_[i] = nodes.velocity_new[i] - nodes.velocity[i];
+    if (!(nodes.mass[i] > 0.0)) return;
+    const IVec<D> j = grid.multi_index(i);
+    typename PlaneFit<D>::Matrix M = PlaneFit<D>::Matrix::Zero();
+    Eigen::Matrix<double, n_basis, D> load = Eigen::Matrix<double, n_basis, D>::Zero();
+    std::array<int, D> k{};
+    for (int s = 0; s < pow3(D); ++s) {
+      IVec<D> jn = j;
+      Vec<D> r;
+      double w = 1.0;
+      for (int a = 0; a < D; ++a) {
+        jn[a] += k[a] - 1;
+        r[a] = k[a] - 1;
+        w *= wide_weight(r[a], 1.0);
+      }
+      for (int a = 0; a < D; ++a) {
+        if (++k[a] < 3) break;
+        k[a] = 0;
+      }
+      const std::int32_t nb = grid.node_index(jn);
+      if (nb < 0 || !(nodes.mass[nb] > 0.0)) continue;
+      w *= nodes.mass[nb];
+      const auto b = PlaneFit<D>::basis(r);
+      M += w * b * b.transpose();
+      load += w * b * (nodes.velocity_new[nb] - nodes.velocity[nb]).transpose();
+    }
+    const auto inverse = PlaneFit<D>::inverse(M, false);
+    filtered_[i] = (inverse.row(0) * load).transpose();
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) { nodes.velocity_new[i] = nodes.velocity[i] + filtered_[i]; });
+}
+
+template <int D>
 void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
   // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
   // (the strain rate the internal force of Eq. 24 is the power conjugate of) ...

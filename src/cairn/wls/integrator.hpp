@@ -89,6 +89,10 @@ class Integrator {
   /// integration points' gradients.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);
 
+  /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
+  /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.
+  void filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes);
+
   // ---- inspection (tests, snapshots) ----------------------------------------------------------
   [[nodiscard]] const std::vector<double>& signed_distance() const { return distance_; }
   /// 1 where the node's least-squares fit is well conditioned (alpha_i of Eq. 19-21).
@@ -151,6 +155,7 @@ class Integrator {
   std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
+  std::vector<Vec<D>> filtered_;                              ///< scratch of filter_acceleration
 };
 
 /// The integration regions as points for a snapshot (ParaView): position = centroid, volume0 =
