@@ -18,29 +18,31 @@ namespace {
 
 constexpr const char* format_name = "cairn-checkpoint";
 
+/// Space vectors are stored n x 3 (zero beyond D), the shape snapshots use (format version 2).
 template <int D>
-void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v) {
-  std::vector<double> buffer(D * v.size());
-  for (std::size_t p = 0; p < v.size(); ++p)
-    for (int a = 0; a < D; ++a) buffer[D * p + a] = v[p][a];
-  h5::write_doubles(loc, name, buffer.data(), v.size(), D);
+void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, int deflate) {
+  static_assert(sizeof(Vec<D>) == D * sizeof(double), "Vec<D> must be D packed doubles");
+  h5::write_doubles_padded(loc, name, reinterpret_cast<const double*>(v.data()), v.size(), D, 3, deflate);
 }
 
+/// Reads n x 3 (version 2) or n x D (version 1) vectors.
 template <int D>
 std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t n) {
-  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, static_cast<std::size_t>(D)});
+  const std::vector<std::size_t> shape = h5::dataset_shape(loc, name);
+  const std::size_t cols = shape.size() == 2 && shape[1] == 3 ? 3 : static_cast<std::size_t>(D);
+  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, cols});
   std::vector<Vec<D>> v(n);
   for (std::size_t p = 0; p < n; ++p)
-    for (int a = 0; a < D; ++a) v[p][a] = buffer[D * p + a];
+    for (int a = 0; a < D; ++a) v[p][a] = buffer[cols * p + a];
   return v;
 }
 
-void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m) {
+void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m, int deflate) {
   std::vector<double> buffer(9 * m.size());
   for (std::size_t p = 0; p < m.size(); ++p)
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) buffer[9 * p + 3 * i + j] = m[p](i, j);
-  h5::write_doubles(loc, name, buffer.data(), m.size(), 9);
+  h5::write_doubles(loc, name, buffer.data(), m.size(), 9, deflate);
 }
 
 std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
@@ -95,9 +97,9 @@ h5::Handle open_checkpoint(const fs::path& path, int& dimension) {
                              format + "', expected '" + format_name + "')");
   }
   const long long version = h5::read_int64_attribute(root, "version");
-  if (version != checkpoint_format_version) {
+  if (version < 1 || version > checkpoint_format_version) {
     throw std::runtime_error(fmt::format(
-        "checkpoint '{}' has format version {}, but this build of Cairn reads only version {}",
+        "checkpoint '{}' has format version {}, but this build of Cairn reads versions 1 to {}",
         path.string(), version, checkpoint_format_version));
   }
   const long long dim = h5::read_int64_attribute(root, "dimension");
@@ -131,6 +133,9 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
     h5::write_double_attribute(root, "previous_dt", data.previous_dt);
     h5::write_int64_attribute(root, "snapshot_next_index", data.snapshot_next_index);
     h5::write_text(root, "config_toml", data.config_toml);
+    OutputMetadata meta = data.metadata;
+    meta.input_toml = data.config_toml;  // input_sha256 fingerprints /config_toml
+    h5::write_metadata(root, meta, false);
     {
       h5::Handle g = h5::create_group(root, "scalars");
       std::vector<std::string> names;
@@ -164,23 +169,24 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
     {
       const Particles<D>& ps = data.particles;
       const std::size_t n = ps.n();
+      const int z = data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
       h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);
-      write_vecs<D>(gid, "position", ps.position);
-      write_vecs<D>(gid, "reference_position", ps.reference_position);
-      write_vecs<D>(gid, "velocity", ps.velocity);
+      write_vecs<D>(gid, "position", ps.position, z);
+      write_vecs<D>(gid, "reference_position", ps.reference_position, z);
+      write_vecs<D>(gid, "velocity", ps.velocity, z);
       h5::write_doubles(gid, "mass", ps.mass.data(), n);
       h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
       h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
-      write_vecs<D>(gid, "size0", ps.size0);
-      write_mats(gid, "deformation_gradient", ps.deformation_gradient);
-      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
-      write_mats(gid, "velocity_gradient", ps.velocity_gradient);
-      write_mats(gid, "affine_velocity", ps.affine_velocity);
+      write_vecs<D>(gid, "size0", ps.size0, z);
+      write_mats(gid, "deformation_gradient", ps.deformation_gradient, z);
+      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, z);
+      write_mats(gid, "velocity_gradient", ps.velocity_gradient, z);
+      write_mats(gid, "affine_velocity", ps.affine_velocity, z);
       h5::write_ints(gid, "material", ps.material.data(), n);
       h5::write_ints(gid, "body", ps.body.data(), n);
-      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size());
+      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size(), 0, z);
     }
     write_content_checksum(root);  // last: it covers everything above
   });

@@ -37,6 +37,7 @@ struct SimulationConfig {
   long long max_steps = 0;  ///< 0: no limit
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
+  std::string units = "SI"; ///< declared unit system (labels the output; io/units.hpp)
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
   double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
   std::string body_overlap = "error";  ///< bodies sharing space: error | warn
@@ -90,8 +91,9 @@ struct GreyImage;  // io/image.hpp
 struct BodyShapeConfig {
   std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | image
   std::vector<double> min, max;         ///< box
-  std::vector<double> center;           ///< circle, ellipse, annulus, sphere
-  double radius = 0.0;                  ///< circle, sphere
+  std::vector<double> center;           ///< circle, ellipse, annulus, sphere, cylinder
+  double radius = 0.0;                  ///< circle, sphere, cylinder
+  double height = 0.0;                  ///< cylinder (3D, axis along +z from center)
   std::vector<double> semi_axes;        ///< ellipse (2D) / ellipsoid (3D)
   double inner_radius = 0.0, outer_radius = 0.0;  ///< annulus
   std::vector<std::vector<double>> vertices;      ///< polygon (2D)
@@ -216,6 +218,25 @@ struct ContactConfig {
   [[nodiscard]] bool enabled() const { return mode != "none"; }
 };
 
+/// [fem]: the reference explicit FEM of seed 001 Appendix A (docs/fem.md). When enabled the run
+/// has no grid and no particles: [grid] and [[body]] are absent and the mesh is the body.
+struct FemConfig {
+  bool enabled = false;
+  std::string material;             ///< name of a [[material]]
+  std::string mesh_file;            ///< Gmsh .msh file (absolute once loaded); "" = generate from shape
+  BodyShapeConfig shape;            ///< generated mesh: box | circle | ellipse | annulus | polygon
+  std::vector<double> hole_center;  ///< D values: circular hole cut from the shape; empty = none
+  double hole_radius = 0.0;
+  double size = 0.0;                ///< characteristic element size of generated meshes
+  std::string mesher = "gmsh";      ///< gmsh | structured
+  std::vector<std::string> velocity;      ///< D expressions in X,Y: initial velocity
+  std::vector<std::string> displacement;  ///< D expressions in X,Y; empty = none
+  /// D expressions in X,Y,t: an exact displacement; history.csv then gets the node error of
+  /// seed 001 Eq. 38 every step (displacement_error, and its maximum over all steps so far).
+  std::vector<std::string> exact_displacement;
+  SourceLocation where;
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -226,6 +247,8 @@ struct OutputConfig {
   bool checkpoints = true;
   /// D expressions of the exact displacement u(X, t) (manufactured solutions); empty = none.
   std::vector<std::string> exact_displacement;
+  double checkpoint_wall_interval = 1800.0;  ///< wall-clock seconds between checkpoints; 0 = off
+  int compression = 0;          ///< gzip level 0-9 of large HDF5 datasets; 0 = off
 };
 
 struct Config {
@@ -244,6 +267,7 @@ struct Config {
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
   ThermalConfig thermal;
   ContactConfig contact;
+  FemConfig fem;
   OutputConfig output;
   /// Values that are valid but suspicious (e.g. a density of 1e308), one message each with file,
   /// line and key; the CLI prints them.

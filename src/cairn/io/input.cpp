@@ -392,6 +392,8 @@ class Loader {
   void read_velocity_conditions(const toml::table& root, Config& cfg);
   void read_walls(const toml::table& root, Config& cfg);
   void read_contact(const toml::table& root, Config& cfg);
+  /// [fem] (docs/fem.md): a mesh instead of [grid] and [[body]]; rejects the MPM-only sections.
+  void read_fem(const toml::table& root, Config& cfg);
   /// box_min/box_max of a selection: both or neither, max >= min on every axis.
   void read_box(TableReader& r, std::vector<double>& lo, std::vector<double>& hi);
   TimeTable read_table(TableReader& r);
@@ -897,6 +899,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
+  s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
   s.max_estimated_steps = r.real("max_estimated_steps");
   s.body_overlap = r.string("body_overlap");
@@ -1112,6 +1115,10 @@ BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConf
   } else if (kind == "circle" || kind == "sphere") {
     s.center = r.reals("center", n, false);
     s.radius = r.real("radius");
+  } else if (kind == "cylinder") {
+    s.center = r.reals("center", n, false);
+    s.radius = r.real("radius");
+    s.height = r.real("height");
   } else if (kind == "ellipse") {
     s.center = r.reals("center", n, false);
     s.semi_axes = r.reals("semi_axes", n, false);
@@ -1456,6 +1463,73 @@ void Loader::read_walls(const toml::table& root, Config& cfg) {
   }
 }
 
+void Loader::read_fem(const toml::table& root, Config& cfg) {
+  // An FEM run has no grid and no particles: the sections that describe them, or features the
+  // FEM does not implement, are errors rather than silently ignored.
+  for (const char* other : {"grid", "method", "body", "traction", "wall", "contact", "contact_pair", "thermal"})
+    if (const toml::node* node = root.get(other))
+      fail({other}, node,
+           fmt::format("no [{}] in an FEM run ([fem] meshes the body; docs/fem.md lists what the FEM "
+                       "supports)", other),
+           fmt::format("[{}]", other));
+  const toml::table* t = section(root, "fem");
+  if (!t) fail({"fem"}, root.get("fem"), "a table, written [fem]", typed_text(*root.get("fem")));
+  TableReader r(*this, t, {"fem"}, copy_section("fem"), "[fem]");
+  r.reject_unknown_keys();
+  if (dim_ != 2)
+    fail({"simulation", "dimension"}, nullptr, "dimension = 2 for an FEM run (linear triangles)",
+         fmt::format("{}", dim_));
+  auto& f = cfg.fem;
+  f.enabled = true;
+  f.where = {file_, line_of(t)};
+  std::vector<std::string> material_names;
+  for (const auto& m : cfg.materials) material_names.push_back(m.name);
+  f.material = r.string("material");
+  if (std::find(material_names.begin(), material_names.end(), f.material) == material_names.end())
+    r.fail("material", r.given("material"),
+           material_names.empty() ? std::string("the name of a [[material]] (the input has none)")
+                                  : "the name of a [[material]], one of " + join(material_names) +
+                                        did_you_mean(f.material, material_names),
+           toml_string(f.material));
+  const auto n = static_cast<std::size_t>(dim_);
+  const std::string file = r.string("mesh_file");
+  if (file.empty() == !r.present("shape"))
+    fail({"fem"}, t, "exactly one of fem.mesh_file (a Gmsh .msh file) and fem.shape (a generated mesh)",
+         file.empty() ? "neither" : "both");
+  if (!file.empty()) {
+    f.mesh_file = resolve_input_relative(file, file_);
+  } else {
+    f.shape = read_shape(r, {});
+    if (f.shape.kind == "image")
+      r.fail("shape", r.given("shape"), "a shape the mesher can generate: box, circle, ellipse, annulus or polygon",
+             "image");
+  }
+  f.hole_radius = r.real("hole_radius");
+  if (f.hole_radius > 0.0) {
+    if (!file.empty()) r.fail("hole_radius", r.given("hole_radius"), "no hole with a mesh_file (the file is the mesh)",
+                              real_text(f.hole_radius));
+    f.hole_center = r.reals("hole_center", n, false);
+  } else if (r.present("hole_center")) {
+    r.fail("hole_center", r.given("hole_center"), "hole_radius > 0 with hole_center", "hole_radius = 0");
+  }
+  f.size = r.real("size");
+  if (file.empty() && !(f.size > 0.0))
+    r.fail("size", r.given("size"), "an element size > 0 for a generated mesh", real_text(f.size));
+  f.mesher = r.string("mesher");
+  if (f.mesher == "structured" && file.empty() && f.shape.kind != "box" && f.shape.kind != "annulus")
+    r.fail("mesher", r.given("mesher"), "\"gmsh\" for a " + f.shape.kind +
+           " (the structured mesher makes boxes and annuli)", toml_string(f.mesher));
+  if (f.mesher == "structured" && f.hole_radius > 0.0)
+    r.fail("mesher", r.given("mesher"), "\"gmsh\" for a shape with a hole", toml_string(f.mesher));
+  f.velocity = r.expressions("velocity", n, ExpressionVars::initial);
+  if (f.velocity.empty()) f.velocity.assign(n, "0");
+  f.displacement = r.expressions("displacement", n, ExpressionVars::initial);
+  f.exact_displacement = r.expressions("exact_displacement", n, ExpressionVars::field);
+  for (int face = 0; face < 2 * dim_; ++face)
+    if (cfg.boundary.face[face] == FaceCondition::periodic)
+      fail({"boundary", face_names[face]}, nullptr, "fixed, symmetry or free in an FEM run", "\"periodic\"");
+}
+
 void Loader::read_output(const toml::table& root, Config& cfg) {
   TableReader r(*this, section(root, "output"), {"output"}, copy_section("output"), "[output]");
   r.reject_unknown_keys();
@@ -1472,6 +1546,8 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.grid_snapshots = r.boolean("grid_snapshots");
   o.checkpoints = r.boolean("checkpoints");
   o.exact_displacement = r.expressions("exact_displacement", static_cast<std::size_t>(dim_), ExpressionVars::field);
+  o.checkpoint_wall_interval = r.real("checkpoint_wall_interval");
+  o.compression = r.small_integer("compression");
 }
 
 void Loader::read_contact(const toml::table& root, Config& cfg) {
@@ -1549,12 +1625,14 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   Config cfg;
   cfg.source_file = file_;
   read_simulation(root, cfg);
-  read_grid(root, cfg);
+  const bool fem = root.contains("fem");
+  if (!fem) read_grid(root, cfg);
   read_method(root, cfg);
   read_constants(root, cfg);
   read_materials(root, cfg);
-  read_bodies(root, cfg);
+  if (!fem) read_bodies(root, cfg);
   read_boundary(root, cfg);
+  if (fem) read_fem(root, cfg);
   read_body_force(root, cfg);
   read_thermal(root, cfg);
   read_tractions(root, cfg);
@@ -1594,6 +1672,9 @@ std::string shape_text(const BodyShapeConfig& s) {
     params = fmt::format("center = {}, radius = {}", reals_text(s.center), real_text(s.radius));
   else if (s.kind == "ellipse")
     params = fmt::format("center = {}, semi_axes = {}", reals_text(s.center), reals_text(s.semi_axes));
+  else if (s.kind == "cylinder")
+    params = fmt::format("center = {}, radius = {}, height = {}", reals_text(s.center), real_text(s.radius),
+                         real_text(s.height));
   else if (s.kind == "annulus")
     params = fmt::format("center = {}, inner_radius = {}, outer_radius = {}", reals_text(s.center),
                          real_text(s.inner_radius), real_text(s.outer_radius));
@@ -1625,36 +1706,39 @@ std::string config_to_toml(const Config& c) {
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
+  line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));
   line("max_estimated_steps", real_text(s.max_estimated_steps));
   line("body_overlap", toml_string(s.body_overlap));
 
-  o += "\n[grid]\n";
-  line("origin", reals_text(c.grid.origin));
-  line("extent", reals_text(c.grid.extent));
-  line("cell_size", reals_text(c.grid.cell_size));
+  if (!c.fem.enabled) {
+    o += "\n[grid]\n";
+    line("origin", reals_text(c.grid.origin));
+    line("extent", reals_text(c.grid.extent));
+    line("cell_size", reals_text(c.grid.cell_size));
 
-  const auto& m = c.method;
-  o += "\n[method]\n";
-  line("shape", toml_string(m.shape));
-  line("update", toml_string(m.update));
-  line("order", fmt::format("{}", m.order));
-  line("stress_update", toml_string(m.stress_update));
-  line("smoothing_length", real_text(m.smoothing_length));
-  line("cpdi_max_span", real_text(m.cpdi_max_span));
-  line("beta", real_text(m.beta));
-  line("blend_position", toml_string(m.blend_position));
-  line("grid_damping", real_text(m.grid_damping));
-  line("particle_damping", real_text(m.particle_damping));
-  line("full_mass_cfl", real_text(m.full_mass_cfl));
-  line("velocity_bc_method", toml_string(m.velocity_bc_method));
-  line("time_integration", toml_string(m.time_integration));
-  line("integration", toml_string(m.integration));
-  line("trigger_weight", real_text(m.trigger_weight));
-  line("surface_distance", toml_string(m.surface_distance));
-  line("spurious_force", toml_string(m.spurious_force));
-  line("velocity_gradient", toml_string(m.velocity_gradient));
-  line("filter_acceleration", m.filter_acceleration ? "true" : "false");
+    const auto& m = c.method;
+    o += "\n[method]\n";
+    line("shape", toml_string(m.shape));
+    line("update", toml_string(m.update));
+    line("order", fmt::format("{}", m.order));
+    line("stress_update", toml_string(m.stress_update));
+    line("smoothing_length", real_text(m.smoothing_length));
+    line("cpdi_max_span", real_text(m.cpdi_max_span));
+    line("beta", real_text(m.beta));
+    line("blend_position", toml_string(m.blend_position));
+    line("grid_damping", real_text(m.grid_damping));
+    line("particle_damping", real_text(m.particle_damping));
+    line("full_mass_cfl", real_text(m.full_mass_cfl));
+    line("velocity_bc_method", toml_string(m.velocity_bc_method));
+    line("time_integration", toml_string(m.time_integration));
+    line("integration", toml_string(m.integration));
+    line("trigger_weight", real_text(m.trigger_weight));
+    line("surface_distance", toml_string(m.surface_distance));
+    line("spurious_force", toml_string(m.spurious_force));
+    line("velocity_gradient", toml_string(m.velocity_gradient));
+    line("filter_acceleration", m.filter_acceleration ? "true" : "false");
+  }
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";
@@ -1694,6 +1778,23 @@ std::string config_to_toml(const Config& c) {
     if (b.clip) line("clip", "true");
     line("arrangement", toml_string(b.arrangement));
   }
+  if (c.fem.enabled) {
+    const auto& f = c.fem;
+    o += "\n[fem]\n";
+    line("material", toml_string(f.material));
+    if (!f.mesh_file.empty()) line("mesh_file", toml_string(f.mesh_file));
+    else line("shape", shape_text(f.shape));
+    if (f.hole_radius > 0.0) {
+      line("hole_center", reals_text(f.hole_center));
+      line("hole_radius", real_text(f.hole_radius));
+    }
+    line("size", real_text(f.size));
+    line("mesher", toml_string(f.mesher));
+    line("velocity", array_text(f.velocity, expression_text));
+    if (!f.displacement.empty()) line("displacement", array_text(f.displacement, expression_text));
+    if (!f.exact_displacement.empty())
+      line("exact_displacement", array_text(f.exact_displacement, expression_text));
+  }
 
   o += "\n[boundary]\n";
   for (int f = 0; f < 2 * s.dimension && f < 6; ++f)
@@ -1701,14 +1802,16 @@ std::string config_to_toml(const Config& c) {
   line("acceleration", toml_string(c.boundary.acceleration == BoundaryAcceleration::zero ? "zero"
                                                                                   : "velocity_change"));
 
-  o += "\n[thermal]\n";
-  line("conduction", boolean(c.thermal.conduction));
-  for (int f = 0; f < 2 * s.dimension && f < 6; ++f) {
-    const ThermalFace tf = c.thermal.face[f];
-    line(face_names[f], toml_string(tf == ThermalFace::temperature ? "temperature"
-                                    : tf == ThermalFace::flux      ? "flux"
-                                                                   : "adiabatic"));
-    line(std::string(face_names[f]) + "_value", real_text(c.thermal.value[f]));
+  if (!c.fem.enabled) {
+    o += "\n[thermal]\n";
+    line("conduction", boolean(c.thermal.conduction));
+    for (int f = 0; f < 2 * s.dimension && f < 6; ++f) {
+      const ThermalFace tf = c.thermal.face[f];
+      line(face_names[f], toml_string(tf == ThermalFace::temperature ? "temperature"
+                                      : tf == ThermalFace::flux      ? "flux"
+                                                                     : "adiabatic"));
+      line(std::string(face_names[f]) + "_value", real_text(c.thermal.value[f]));
+    }
   }
 
   if (!c.body_force.expression.empty()) {
@@ -1766,7 +1869,7 @@ std::string config_to_toml(const Config& c) {
   }
 
   const auto& out = c.output;
-  {
+  if (!c.fem.enabled) {
     const ContactConfig& ct = c.contact;
     auto law_lines = [&](const ContactLawConfig& law) {
       line("law", toml_string(law.law));
@@ -1803,6 +1906,8 @@ std::string config_to_toml(const Config& c) {
   line("checkpoints", boolean(out.checkpoints));
   if (!out.exact_displacement.empty())
     line("exact_displacement", array_text(out.exact_displacement, expression_text));
+  line("checkpoint_wall_interval", real_text(out.checkpoint_wall_interval));
+  line("compression", fmt::format("{}", out.compression));
   return o;
 }
 
@@ -1827,7 +1932,18 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
   if (!in) throw InputError(path, 0, "", "a readable input file", std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  return load_config_string(text.str(), path, overrides);
+  Config cfg = load_config_string(text.str(), path, overrides);
+  // A relative output folder from the file (or the default out/<stem>) lies next to the input
+  // file; one given with --set is relative to the working directory, as typed.
+  bool from_command_line = false;
+  for (const auto& o : overrides)
+    from_command_line = from_command_line || trim(o.substr(0, o.find('='))) == "output.directory";
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!from_command_line && !folder.empty() && std::filesystem::path(cfg.output.directory).is_relative()) {
+    cfg.output.directory = (folder / cfg.output.directory).lexically_normal().string();
+    cfg.resolved_toml = config_to_toml(cfg);
+  }
+  return cfg;
 }
 
 }  // namespace cairn

@@ -643,9 +643,10 @@ void Simulation<D>::update_particles(double dt) {
     Effective<D> e = scheme.effective(g);
     e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
     const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.50.
+    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+    // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
     const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    particle_scalar_[p] = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+    particle_scalar_[p] = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
     const Vec<D> x_old = P.position[p];
     P.velocity[p] += e.A_dt;
     P.position[p] += dX;
