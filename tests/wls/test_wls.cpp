@@ -541,6 +541,60 @@ TEST(WlsIntegration, RigidTranslationStaysUndeformed) {
   }
 }
 
+TEST(WlsIntegration, AccelerationFilterPassesLinearFieldsAndDampsZigZag) {
+  // method.filter_acceleration: the planar fit over a node and its neighbours with mass returns a
+  // linear increment field unchanged at every node with mass (also at the surface, where the
+  // neighbourhood is one-sided) and removes most of a node-to-node zig-zag.
+  Simulation<2> sim(wls_config(2, "circle", 0.05));
+  const auto& grid = sim.grid();
+  wls::Integrator<2> filter(grid, wls::Options{});
+  NodeField<2> nodes = sim.nodes();
+  const Vec<2> c0(0.3, -0.2);
+  Eigen::Matrix2d A;
+  A << 0.7, -0.4, 0.2, 1.1;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    nodes.velocity[i] = Vec<2>(0.05 * i, -0.01 * i);  // any v: the filter acts on v+ - v
+    nodes.velocity_new[i] = nodes.velocity[i] + c0 + A * grid.node_position(i);
+  }
+  filter.filter_acceleration(grid, nodes);
+  int with_mass = 0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    if (!(nodes.mass[i] > 0.0)) continue;
+    ++with_mass;
+    EXPECT_NEAR((nodes.velocity_new[i] - nodes.velocity[i] - c0 - A * grid.node_position(i)).norm(), 0.0, 1e-12) << i;
+  }
+  EXPECT_GT(with_mass, 100);
+  double before = 0.0, after = 0.0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    const IVec<2> j = grid.multi_index(i);
+    nodes.velocity[i] = Vec<2>::Zero();
+    nodes.velocity_new[i] = Vec<2>((j[0] + j[1]) % 2 ? 1.0 : -1.0, 0.0);
+  }
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i)
+    if (nodes.mass[i] > 0.0 && sim.wls()->well_conditioned()[i]) before = std::max(before, nodes.velocity_new[i].norm());
+  filter.filter_acceleration(grid, nodes);
+  // Where the node and its 8 neighbours carry the same mass the fit is the W-weighted mean over
+  // the symmetric stencil: 0.75^2 - 4 (0.75 0.125) + 4 0.125^2 = 0.25 of the zig-zag.
+  int uniform = 0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    if (!(nodes.mass[i] > 0.0)) continue;
+    const IVec<2> j = grid.multi_index(i);
+    bool same = true;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) {
+        const std::int32_t nb = grid.node_index(IVec<2>(j[0] + dx, j[1] + dy));
+        same = same && nb >= 0 && std::abs(nodes.mass[nb] - nodes.mass[i]) <= 1e-12 * nodes.mass[i];
+      }
+    if (!same) continue;
+    ++uniform;
+    after = std::max(after, nodes.velocity_new[i].norm());
+    EXPECT_NEAR(nodes.velocity_new[i].norm(), 0.25, 1e-12) << i;
+  }
+  EXPECT_EQ(before, 1.0);
+  EXPECT_GT(uniform, 20);
+  EXPECT_LT(after, 0.25 + 1e-12);
+}
+
 TEST(WlsIntegration, UniformStressGivesNoInteriorForce) {
   // A uniformly stretched box: the internal force of every node whose cells are all full
   // vanishes (the stress divergence is zero); the boundary nodes carry the traction.

@@ -72,7 +72,7 @@ struct MethodConfig {
   std::string surface_distance = "distance";     ///< WLS near-surface distance: projection | distance
   std::string spurious_force = "per_mass";       ///< WLS spurious-node internal force: per_mass | force
   std::string velocity_gradient = "quadrature";  ///< WLS particle velocity gradient: quadrature | narrow
-  bool filter_acceleration = true;               ///< WLS: planar node filter of the grid velocity increments
+  bool filter_acceleration = false;              ///< WLS: planar node filter of the grid velocity increments
 };
 
 /// A material's parameters after validation against the model's declared keys (defaults filled).

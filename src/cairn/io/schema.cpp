@@ -242,9 +242,9 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("method", "filter_acceleration", T::boolean,
                  "WLS: replace each node's velocity increment a dt by the planar least-squares "
                  "fit over it and its neighbours with mass (weights W m), so linear fields pass "
-                 "and the node-to-node zig-zag of small cut cells does not (docs/wls.md); false = "
-                 "seed 001 as printed.")
-                .by_default("true"));
+                 "and the node-to-node zig-zag of small cut cells does not (docs/wls.md; not "
+                 "energy conserving); false = seed 001 as printed.")
+                .by_default("false"));
 
   // [[material]] (the model's own keys come from material_model_info())
   k.push_back(Key("material", "name", T::string,
