@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <sys/ioctl.h>
+#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <exception>
 #include <regex>
 
+#include "cairn/bc/expression.hpp"
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/run.hpp"
 #include "cairn/io/checkpoint.hpp"
@@ -22,6 +24,7 @@
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/integrator.hpp"
 
 namespace cairn {
 namespace {
@@ -101,6 +104,10 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
     for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
   for (const auto& wall : sim.velocity_conditions().walls())
     columns.push_back(fmt::format("wall_{}_position", wall.name()));
+  if (!sim.config().output.exact_displacement.empty()) {
+    columns.push_back("displacement_error");
+    columns.push_back("displacement_error_max");
+  }
   if (const auto* c = sim.contact()) {
     columns.push_back("contact_nodes");
     columns.push_back("contact_active");
@@ -139,6 +146,11 @@ class Runner {
     history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
     checkpoint_.interval = out.checkpoint_every;
     std::filesystem::create_directories(dir_);
+    // WLS: the integration regions (cut cells) beside every particle snapshot, wls_cells.xdmf.
+    if (sim_.wls()) cells_ = std::make_unique<SnapshotWriter<D>>(dir_, "wls_cells");
+    if (!out.exact_displacement.empty())
+      for (int t = 0; t < omp_get_max_threads(); ++t)
+        exact_.push_back(std::make_unique<ExpressionVector<D>>(out.exact_displacement, config_.constants));
     remove_orphan_temporaries(dir_);
     remove_orphan_temporaries(dir_ / "snapshots");
   }
@@ -165,6 +177,7 @@ class Runner {
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
+    if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
     snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
     history_.done = static_cast<long long>(data.scalars.at("history_done"));
     checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
@@ -174,6 +187,13 @@ class Runner {
     // Every output ends where the checkpoint stands, before the first new step.
     history_writer_.flush();
     snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
+    if (cells_) {
+      // The region files are written in step with the particle files: same index, other stem.
+      auto entries = data.snapshot_entries;
+      for (auto& [time, file] : entries)
+        if (file.rfind("particles-", 0) == 0) file = "wls_cells-" + file.substr(10);
+      cells_->restore(entries, data.snapshot_next_index);
+    }
     restarted_ = true;
   }
 
@@ -187,6 +207,7 @@ class Runner {
       if (const std::string note = time_step_note(config_); !note.empty())
         std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
+      measure_error();
       write_history_row();
       write_snapshot();
     }
@@ -199,6 +220,7 @@ class Runner {
         fail(f, dt);
       }
       last_dt_ = dt;
+      measure_error();
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
       const double t = sim_.time();
       wrote_history = wrote_snapshot = false;
@@ -257,6 +279,26 @@ class Runner {
     return t.kinetic_energy + t.strain_energy;
   }
 
+  /// Eq. 38 of seed 001: the largest |x_p - X_p - u(X_p, t)| now, and over every step so far.
+  void measure_error() {
+    if (exact_.empty()) return;
+    const auto& P = sim_.particles();
+    const auto n = static_cast<std::int64_t>(P.n());
+    const double t = sim_.time();
+    double worst = 0.0;
+#pragma omp parallel reduction(max : worst)
+    {
+      auto& u = *exact_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+      for (std::int64_t p = 0; p < n; ++p) {
+        const Vec<D>& X = P.reference_position[p];
+        worst = std::max(worst, (P.position[p] - X - u(X, X, t)).norm());
+      }
+    }
+    error_now_ = worst;
+    error_max_ = std::max(error_max_, worst);
+  }
+
   void write_history_row() {
     const Totals t = sim_.totals();
     const double total = t.kinetic_energy + t.strain_energy;
@@ -267,6 +309,10 @@ class Runner {
     for (const auto& r : sim_.velocity_conditions().reactions())
       for (int a = 0; a < D; ++a) row.push_back(r[a]);
     for (const auto& wall : sim_.velocity_conditions().walls()) row.push_back(wall.position());
+    if (!exact_.empty()) {
+      row.push_back(error_now_);
+      row.push_back(error_max_);
+    }
     if (const auto* c = sim_.contact()) {
       row.push_back(static_cast<double>(c->contact_nodes()));
       row.push_back(static_cast<double>(c->active_nodes()));
@@ -294,6 +340,8 @@ class Runner {
     }
     else
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    // The regions of the last step (none before the first step).
+    if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
 
   /// A numbered checkpoint-NNNN.h5, or (autosave: wall-clock interval, signals) the one
@@ -316,6 +364,7 @@ class Runner {
                     {"checkpoint_index", static_cast<double>(checkpoint_index_)}};
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
+    if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
@@ -413,6 +462,9 @@ class Runner {
   Schedule history_, snapshot_, checkpoint_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
+  std::unique_ptr<SnapshotWriter<D>> cells_;  ///< WLS integration regions
+  std::vector<std::unique_ptr<ExpressionVector<D>>> exact_;  ///< [output] exact_displacement, per thread
+  double error_now_ = 0.0, error_max_ = 0.0;
   double initial_energy_ = 0.0;
   double last_dt_ = 0.0;
   int checkpoint_index_ = 0;

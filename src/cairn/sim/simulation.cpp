@@ -14,6 +14,7 @@
 #include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/integrator.hpp"
 
 namespace cairn {
 
@@ -92,6 +93,38 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
+  if (config_.method.integration == "wls") {
+    // The WLS method (seed 001) replaces the particle transfers; features that act through
+    // them are not defined for it.
+    const char* unsupported = D == 1                          ? "a 1D simulation"
+                              : config_.contact.enabled()     ? "[contact]"
+                              : config_.thermal.conduction    ? "[thermal] conduction"
+                              : !config_.tractions.empty()    ? "[[traction]]"
+                              : !config_.walls.empty()        ? "[[wall]]"
+                                                              : nullptr;
+    for (int a = 0; a < D && !unsupported; ++a)
+      if (grid_.periodic(a)) unsupported = "periodic faces";
+    if (unsupported)
+      throw std::invalid_argument(std::string("method.integration = \"wls\" does not support ") + unsupported +
+                                  " (docs/wls.md)");
+    wls::Options o;
+    o.trigger_weight = config_.method.trigger_weight;
+    o.projected_distance = config_.method.surface_distance == "projection";
+    o.average_per_mass = config_.method.spurious_force == "per_mass";
+    o.quadrature_gradient = config_.method.velocity_gradient == "quadrature";
+    // A symmetry face is a mirror plane of the body when the body reaches it at the start
+    // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
+    for (int f = 0; f < 2 * D; ++f) {
+      if (config_.boundary.face[f] != FaceCondition::symmetry) continue;
+      const int a = f / 2;
+      const double plane = f % 2 ? grid_.extent_max()[a] : grid_.origin()[a];
+      for (std::size_t p = 0; p < particles_.n() && !o.mirror[f]; ++p)
+        o.mirror[f] = std::abs(particles_.position[p][a] - plane) < 0.5 * grid_.cell_size()[a];
+    }
+    o.thickness = config_.simulation.thickness;
+    wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
+  }
+
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
     for (int t = 0; t < n_threads; ++t)
@@ -102,6 +135,13 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
   check_run_length<D>(*this);
+  if (wls_) {
+    // The initial node fields and integration regions, so that output at t = 0 shows them.
+    wls_->build_stencils(grid_, particles_);
+    compute_body_forces();
+    wls_->collect(grid_, particles_, material_density_, body_force_.empty() ? nullptr : &body_acceleration_,
+                  nodes_, body_force_.empty() ? nullptr : &node_body_force_);
+  }
 }
 
 template <int D>
@@ -121,9 +161,11 @@ void Simulation<D>::setup_grid() {
     cells[a] = std::llround(g.extent[a] / g.cell_size[a]);
     periodic[a] = wraps[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
-  check_node_count(config_, cells, wraps, shape_->ghost_layers(), velocity_fields(config_));
+  // WLS's wide weight reaches one node beyond a particle's nearest node.
+  const int ghost = std::max(shape_->ghost_layers(), config_.method.integration == "wls" ? 1 : 0);
+  check_node_count(config_, cells, wraps, ghost, velocity_fields(config_));
   for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
-  grid_ = Grid<D>(origin, n_cells, h, shape_->ghost_layers(), periodic);
+  grid_ = Grid<D>(origin, n_cells, h, ghost, periodic);
 }
 
 template <int D>
@@ -142,7 +184,13 @@ template <int D>
 double Simulation<D>::next_dt() const {
   const auto& s = config_.simulation;
   double dt = s.fixed_dt;
-  if (dt <= 0.0) {
+  if (dt <= 0.0 && s.time_step == "nominal") {
+    // seed 001 Eq. 35: the wave speed of the undeformed materials, no particle speed.
+    double c_max = 0.0;
+    for (const auto& m : materials_) c_max = std::max(c_max, m->wave_speed(Mat3::Identity()));
+    dt = s.cfl * grid_.min_cell_size() / c_max;
+    if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
+  } else if (dt <= 0.0) {
     dt = s.cfl * grid_.min_cell_size() / max_signal_speed();  // seed 001 Eq. 34
     if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
   }
@@ -166,6 +214,10 @@ std::vector<std::pair<std::string, double>> Simulation<D>::stage_times() const {
 
 template <int D>
 void Simulation<D>::step(double dt) {
+  if (wls_) {
+    wls_step(dt);
+    return;
+  }
   auto clock = StageClock::now();
   auto lap = [&](int stage) {
     const auto now = StageClock::now();
@@ -240,6 +292,55 @@ void Simulation<D>::step(double dt) {
   }
   lap(5);
   if (conduction_) conduction_->step(cache_, particles_, dt);
+  velocity_conditions_.finish_step();
+  time_ += dt;
+  ++step_;
+}
+
+template <int D>
+void Simulation<D>::wls_step(double dt) {
+  auto clock = StageClock::now();
+  auto lap = [&](int stage) {
+    const auto now = StageClock::now();
+    stage_seconds_[stage] += std::chrono::duration<double>(now - clock).count();
+    clock = now;
+  };
+  step_dt_ = dt;
+  wls_->build_stencils(grid_, particles_);
+  lap(0);
+  // Sec. 4.1-4.5: node mass, least-squares velocity (as m v) and forces.
+  compute_body_forces();
+  const bool has_body_force = !body_force_.empty();
+  wls_->collect(grid_, particles_, material_density_, has_body_force ? &body_acceleration_ : nullptr, nodes_,
+                has_body_force ? &node_body_force_ : nullptr);
+  velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
+  lap(1);
+  update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)
+  if (config_.method.filter_acceleration) {
+    wls_->filter_acceleration(grid_, nodes_);
+    impose_conditions(nodes_.velocity_new, VelocityConditions<D>::When::end);
+  }
+  lap(2);
+  wls_->move_particles(grid_, nodes_, particles_, dt);  // Eq. 27-29 (or the quadrature gradient)
+  lap(4);
+  // Eq. 30: F <- (I + grad V dt) F, then the material.
+  const auto n = static_cast<std::int64_t>(particles_.n());
+  std::int64_t first_bad = -1;
+  std::string what;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < n; ++p) {
+    const Mat3& L = particles_.velocity_gradient[p];
+    const Mat3 dF = Mat3::Identity() + L * dt;
+    if (const char* bad = update_particle(static_cast<std::size_t>(p), L, dF, dt)) {
+#pragma omp critical(cairn_failure)
+      if (first_bad < 0 || p < first_bad) {
+        first_bad = p;
+        what = bad;
+      }
+    }
+  }
+  if (first_bad >= 0) particle_failure(first_bad, what);
+  lap(5);
   velocity_conditions_.finish_step();
   time_ += dt;
   ++step_;
@@ -359,12 +460,16 @@ void Simulation<D>::update_grid(double dt) {
   // Task 3 with the lumped mass: v = m^-1 p, p+ = p + f dt, v+ = m^-1 p+. The staggered central
   // difference start uses half the first acceleration (seed 001 Sec. 4.7, seed 003 Eq. 11-15).
   const double f_scale =
-      (config_.method.time_integration == "central_difference" && step_ == 0) ? 0.5 : 1.0;
+      ((config_.method.time_integration == "central_difference" || wls_) && step_ == 0) ? 0.5 : 1.0;
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (m > small_mass_) {
       nodes_.velocity[i] = nodes_.momentum[i] / m;
       nodes_.velocity_new[i] = (nodes_.momentum[i] + f_scale * nodes_.force[i] * dt) / m;
+    } else if (wls_) {
+      // WLS: the grid velocity is the least-squares fit wherever particles see the node, mass
+      // or not (seed 001 Sec. 4.6); without mass there is no acceleration.
+      nodes_.velocity[i] = nodes_.velocity_new[i] = wls_->node_velocity()[i];
     } else {
       nodes_.velocity[i].setZero();
       nodes_.velocity_new[i].setZero();
@@ -612,17 +717,7 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
     for (std::size_t s = begin; s < end; ++s)
       L.template topLeftCorner<D, D>() += grid_velocity[idx[s]] * cache_.gradient[s].transpose();
     particles_.velocity_gradient[p] = L;
-    Mat3& F = particles_.deformation_gradient[p];
-    const Mat3 dF = tensor_exp(L * dt);
-    F = dF * F;
-    particles_.kirchhoff_stress[p] = stress_for(static_cast<std::size_t>(p), L, dF, dt);
-    const double J = F.determinant();
-    const char* bad = nullptr;
-    if (!particles_.velocity[p].allFinite()) bad = "velocity";
-    else if (!particles_.position[p].allFinite()) bad = "position";
-    else if (!(J > 0.0)) bad = "det F";
-    else if (!particles_.kirchhoff_stress[p].allFinite()) bad = "stress";
-    if (bad) {
+    if (const char* bad = update_particle(static_cast<std::size_t>(p), L, tensor_exp(L * dt), dt)) {
 #pragma omp critical(cairn_failure)
       if (first_bad < 0 || p < first_bad) {
         first_bad = p;
@@ -630,15 +725,31 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
       }
     }
   });
-  if (first_bad >= 0) {
-    const auto p = static_cast<std::size_t>(first_bad);
-    std::string value;
-    if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
-    else value = what + " is not finite";
-    throw SimulationFailure(first_bad, what,
-                            "particle " + std::to_string(first_bad) + " (body " +
-                                std::to_string(particles_.body[p]) + "): " + value);
-  }
+  if (first_bad >= 0) particle_failure(first_bad, what);
+}
+
+template <int D>
+const char* Simulation<D>::update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
+  Mat3& F = particles_.deformation_gradient[p];
+  F = dF * F;
+  particles_.kirchhoff_stress[p] = stress_for(p, L, dF, dt);
+  const double J = F.determinant();
+  if (!particles_.velocity[p].allFinite()) return "velocity";
+  if (!particles_.position[p].allFinite()) return "position";
+  if (!(J > 0.0)) return "det F";
+  if (!particles_.kirchhoff_stress[p].allFinite()) return "stress";
+  return nullptr;
+}
+
+template <int D>
+void Simulation<D>::particle_failure(std::int64_t first_bad, const std::string& what) const {
+  const auto p = static_cast<std::size_t>(first_bad);
+  std::string value;
+  if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
+  else value = what + " is not finite";
+  throw SimulationFailure(first_bad, what,
+                          "particle " + std::to_string(first_bad) + " (body " +
+                              std::to_string(particles_.body[p]) + "): " + value);
 }
 
 template <int D>

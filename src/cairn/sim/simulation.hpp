@@ -24,6 +24,11 @@
 
 namespace cairn {
 
+namespace wls {
+template <int D>
+class Integrator;
+}
+
 /// Global sums reported in history.csv.
 struct Totals {
   double kinetic_energy = 0.0;
@@ -71,6 +76,8 @@ class Simulation {
   [[nodiscard]] const Grid<D>& grid() const { return grid_; }
   /// Node fields; in multimaterial mode field f of node i is entry f * n_nodes + i.
   [[nodiscard]] const NodeField<D>& nodes() const { return nodes_; }
+  /// The WLS method's state (method.integration = "wls", docs/wls.md), or null.
+  [[nodiscard]] const wls::Integrator<D>* wls() const { return wls_.get(); }
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
   /// Node fields summed over the material fields (mass, momentum, velocity_new as m-weighted
@@ -115,6 +122,13 @@ class Simulation {
   /// with conditions, or m~_k^-1 q for FMPM.
   void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
   void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
+  /// One step of the WLS method (seed 001 Sec. 4): its collection replaces the particle
+  /// transfers; the grid update, conditions and material updates are the engine's.
+  void wls_step(double dt);
+  /// F <- dF F and the material stress of particle p; the failing quantity's name, or null.
+  const char* update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// Throw SimulationFailure for particle p and the quantity update_particle named.
+  [[noreturn]] void particle_failure(std::int64_t p, const std::string& what) const;
   /// Multimaterial XPIC/FMPM: out -= m~_(k-1)^-1 m dv^a (seed 004 Eq. 37, seed 000 Eq. 5).
   void subtract_contact_term(std::vector<Vec<D>>& out, int k);
   /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
@@ -158,6 +172,7 @@ class Simulation {
   typename VelocityConditions<D>::When work_when_ = VelocityConditions<D>::When::start;
   double small_mass_ = 0.0;
   std::unique_ptr<Contact<D>> contact_;      ///< multimaterial mode ([contact] mode != none)
+  std::unique_ptr<wls::Integrator<D>> wls_;  ///< method.integration = "wls"
   int n_fields_ = 1;
   std::vector<Vec<D>> contact_dv_;           ///< dv^a of the first correction (slots)
   std::vector<Vec<D>> contact_impulse_;      ///< its non-bonded part, an impulse on the particles (slots)
