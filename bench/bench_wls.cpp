@@ -12,6 +12,7 @@
 
 #include "cairn/io/input.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "run_steps.hpp"
 
 namespace cairn {
 namespace {
@@ -47,22 +48,7 @@ velocity = ["0.5*X - 0.3*Y", "0.5*Y + 0.3*X"]
   return load_config_string(text, "bench_wls.toml", {});
 }
 
-void run_ring(benchmark::State& state, bool wls) {
-  const int threads = static_cast<int>(state.range(0));
-  omp_set_num_threads(threads);
-  Simulation<2> sim(ring_config(wls));
-  const double dt = sim.next_dt();
-  for (int i = 0; i < 3; ++i) sim.step(dt);  // warm up: first stencil build sizes the caches
-  for (auto _ : state) sim.step(dt);
-  // Every particle counts, surface particles (zero volume, WLS only) included: they are fitted.
-  const double n = static_cast<double>(sim.particles().n());
-  state.counters["particles"] = n;
-  state.counters["threads"] = threads;
-  state.counters["particle_steps_per_s"] =
-      benchmark::Counter(n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["particle_steps_per_s_per_core"] = benchmark::Counter(
-      n * static_cast<double>(state.iterations()) / threads, benchmark::Counter::kIsRate);
-}
+void run_ring(benchmark::State& state, bool wls) { bench::run_steps<2>(state, ring_config(wls)); }
 
 void BM_WlsStep_Ring(benchmark::State& state) { run_ring(state, true); }
 void BM_WlsReference_Ring_BSpline2(benchmark::State& state) { run_ring(state, false); }
