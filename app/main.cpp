@@ -141,7 +141,11 @@ int main(int argc, char** argv) {
     std::cerr << "cairn: " << what << "\n" << usage;
     return 2;
   }
-  if (threads > 0) omp_set_num_threads(threads);
+  if (threads > 0) {
+    omp_set_num_threads(threads);
+    // The command line wins over the input file's simulation.threads (docs/robustness.md).
+    overrides.push_back(fmt::format("simulation.threads={}", threads));
+  }
 
   try {
     if (*keys) {
