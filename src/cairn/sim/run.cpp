@@ -524,6 +524,8 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+  // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints them.
+  for (const auto& w : config.warnings) std::fprintf(stderr, "cairn: warning: %s\n", w.c_str());
   return run_dim<D>(config, options, &data);
 }
 }  // namespace
