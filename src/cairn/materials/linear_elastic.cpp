@@ -24,6 +24,7 @@ class LinearElastic final : public Material {
   double wave_speed(const Mat3&) const override {
     return std::sqrt((c_.lambda + 2.0 * c_.shear) / density());
   }
+  bool wave_speed_varies() const override { return false; }
 
  private:
   ElasticConstants c_;

@@ -70,6 +70,7 @@ class NeoHookean final : public Material {
   double wave_speed(const Mat3&) const override {
     return std::sqrt((c_.lambda + 3.0 * c_.shear) / density());  // seed 001 Eq. 33
   }
+  bool wave_speed_varies() const override { return false; }
 
  private:
   ElasticConstants c_;

@@ -61,6 +61,8 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
+  material_in_use_.assign(materials_.size(), 0);
+  for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
   if (config_.thermal.conduction) {
     std::vector<double> k, cp;
     for (const auto& mc : config_.materials) {
@@ -128,14 +130,24 @@ void Simulation<D>::setup_grid() {
 
 template <int D>
 double Simulation<D>::max_signal_speed() const {
+  // Materials whose wave speed does not depend on F are asked once (if they have particles);
+  // max |V| is sqrt(max |V|^2), the same number.
   const auto n = static_cast<std::int64_t>(particles_.n());
-  double c_max = 0.0, v_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v_max)
-  for (std::int64_t p = 0; p < n; ++p) {
-    c_max = std::max(c_max, materials_[particles_.material[p]]->wave_speed(particles_.deformation_gradient[p]));
-    v_max = std::max(v_max, particles_.velocity[p].norm());
+  const auto n_materials = static_cast<std::int32_t>(materials_.size());
+  double c_max = 0.0;
+  std::vector<char> varies(materials_.size(), 0);
+  for (std::int32_t m = 0; m < n_materials; ++m) {
+    varies[m] = materials_[m]->wave_speed_varies();
+    if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
   }
-  return c_max + v_max;
+  double v2_max = 0.0;
+#pragma omp parallel for reduction(max : c_max, v2_max)
+  for (std::int64_t p = 0; p < n; ++p) {
+    const std::int32_t m = particles_.material[p];
+    if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
+    v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
+  }
+  return c_max + std::sqrt(v2_max);
 }
 
 template <int D>
@@ -294,31 +306,43 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   });
   if (forces) compute_body_forces();
   const auto& P = particles_;
-  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
-  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
-    const std::int32_t off = field_offset(p);
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
-      const std::int32_t i = node + off;
-      const double Sm = S * P.mass[p];
-      if (mass_and_momentum) {
-        nodes_.mass[i] += Sm;
-        if (affine) {
-          const Vec<D> dx = node_offset(grid_, node, P.position[p]);
-          nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
-        } else {
-          nodes_.momentum[i] += Sm * P.velocity[p];
+  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1). The
+  // particle's factors (M, V, -V0 tau) are read once, not once per stencil entry, and the entry
+  // loop is compiled without tests for the plain step (all three sums, no affine part, no body
+  // force).
+  using MatD = Eigen::Matrix<double, D, D>;
+  auto extrapolate = [&](auto plain_tag) {
+    constexpr bool plain = decltype(plain_tag)::value;
+    scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      const double M = P.mass[p];
+      const Vec<D> V = P.velocity[p];
+      const MatD stress = -P.volume0[p] * P.kirchhoff_stress[p].template block<D>();
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+        const std::int32_t i = node + off;
+        const double Sm = S * M;
+        if (plain || mass_and_momentum) {
+          nodes_.mass[i] += Sm;
+          if (!plain && affine) {
+            const Vec<D> dx = node_offset(grid_, node, P.position[p]);
+            nodes_.momentum[i] += Sm * (V + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+          } else {
+            nodes_.momentum[i] += Sm * V;
+          }
         }
-      }
-      if (forces) {
-        nodes_.force[i] -= P.volume0[p] * P.kirchhoff_stress[p].template times<D>(G);
-        if (has_body_force) {
-          const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
-          nodes_.force[i] += fb;
-          node_body_force_[i] += fb;
+        if (plain || forces) {
+          nodes_.force[i] += stress * G;
+          if (!plain && has_body_force) {
+            const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
+            nodes_.force[i] += fb;
+            node_body_force_[i] += fb;
+          }
         }
-      }
+      });
     });
-  });
+  };
+  if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
+  else extrapolate(std::false_type{});
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
     tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
@@ -526,7 +550,6 @@ void Simulation<D>::update_particles(double dt) {
   // Task 4 in the unified form (seed 002 Eq. 1.7-1.12): V += A dt, X += VV dt + A dt^2 / 2.
   const UpdateScheme<D>& scheme =
       (scheme_->full_mass() != FullMass::none && !use_full_mass_) ? *flip_ : *scheme_;
-  const bool full = use_full_mass_;
   const bool updated_field = scheme_->full_mass() == FullMass::of_updated;
   const bool affine = scheme.affine();
   const double alpha_g = config_.method.grid_damping, alpha_p = config_.method.particle_damping;
@@ -535,40 +558,44 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
   // The sum is the energy dissipated relative to the non-dissipative FLIP update (seed 002
-  // Eq. 1.50).
-  dissipated_energy_ += gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
-    const std::int32_t off = field_offset(p);
-    GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-      const std::int32_t i = node + off;
-      g.Sv += S * v[i];
-      g.Sv_new += S * v_new[i];
-      if (full) g.Sv_full += S * v_full[i];
-    });
-    if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
-    Effective<D> e = scheme.effective(g);
-    e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
-    const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
-    const Vec<D> x_old = P.position[p];
-    P.velocity[p] += e.A_dt;
-    P.position[p] += dX;
-    if (affine) {
-      // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
-      // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
-      // for every shape family (D = h^2/4 I for quadratic splines).
-      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+  // Eq. 1.50). The entry loop is compiled with and without the full-mass velocity.
+  auto move = [&](auto full_tag) {
+    constexpr bool full = decltype(full_tag)::value;
+    return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
       stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-        const Vec<D> d = node_offset(grid_, node, x_old);
-        B += S * v_new[node + off] * d.transpose();
-        Dp += S * d * d.transpose();
+        const std::int32_t i = node + off;
+        g.Sv += S * v[i];
+        g.Sv_new += S * v_new[i];
+        if (full) g.Sv_full += S * v_full[i];
       });
-      P.affine_velocity[p].setZero();
-      P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
-    }
-    return dissipated;
-  });
+      if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
+      Effective<D> e = scheme.effective(g);
+      e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
+      const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+      const Vec<D> ag_dt = g.Sv_new - g.Sv;
+      const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+      const Vec<D> x_old = P.position[p];
+      P.velocity[p] += e.A_dt;
+      P.position[p] += dX;
+      if (affine) {
+        // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
+        // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
+        // for every shape family (D = h^2/4 I for quadratic splines).
+        Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+        stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+          const Vec<D> d = node_offset(grid_, node, x_old);
+          B += S * v_new[node + off] * d.transpose();
+          Dp += S * d * d.transpose();
+        });
+        P.affine_velocity[p].setZero();
+        P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
+      }
+      return dissipated;
+    });
+  };
+  dissipated_energy_ += use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
 }
 
 template <int D>
@@ -579,8 +606,7 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, dou
                       : nullptr;
   MaterialPoint point{F, L, state, dt};
   point.dF = &dF;
-  const Mat3 tau_old = particles_.kirchhoff_stress[p];
-  point.tau_old = &tau_old;
+  point.tau_old = &particles_.kirchhoff_stress[p];
   point.cell_size = grid_.min_cell_size();
   point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
   const Material& m = *materials_[particles_.material[p]];
@@ -593,22 +619,34 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
+  // The kinematics stay in D dimensions: grad V has only its D x D block, so exp(grad V dt) is
+  // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change.
+  using MatD = Eigen::Matrix<double, D, D>;
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
-    Mat3 L = Mat3::Zero();
+    MatD L_D = MatD::Zero();
     stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
-      L.template topLeftCorner<D, D>() += grid_velocity[node + off] * G.transpose();
+      L_D += grid_velocity[node + off] * G.transpose();
     });
+    const MatD dF_D = tensor_exp<D>(L_D * dt);
     Mat3& F = particles_.deformation_gradient[p];
-    const Mat3 dF = tensor_exp(L * dt);
-    F = dF * F;
-    particles_.kirchhoff_stress[p] = stress_for(static_cast<std::size_t>(p), L, dF, dt);
+    F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+    Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
+    L.template topLeftCorner<D, D>() = L_D;
+    dF.template topLeftCorner<D, D>() = dF_D;
+    const SymMat3 tau = stress_for(static_cast<std::size_t>(p), L, dF, dt);
+    particles_.kirchhoff_stress[p] = tau;
     const double J = F.determinant();
+    // One test for the common case: a sum is finite only if every term is.
     const char* bad = nullptr;
-    if (!particles_.velocity[p].allFinite()) bad = "velocity";
-    else if (!particles_.position[p].allFinite()) bad = "position";
-    else if (!(J > 0.0)) bad = "det F";
-    else if (!particles_.kirchhoff_stress[p].allFinite()) bad = "stress";
+    if (!std::isfinite(particles_.velocity[p].sum() + particles_.position[p].sum() + tau.trace() +
+                       tau(1, 2) + tau(0, 2) + tau(0, 1)) ||
+        !(J > 0.0)) {
+      if (!particles_.velocity[p].allFinite()) bad = "velocity";
+      else if (!particles_.position[p].allFinite()) bad = "position";
+      else if (!(J > 0.0)) bad = "det F";
+      else if (!tau.allFinite()) bad = "stress";
+    }
     if (bad) {
 #pragma omp critical(cairn_failure)
       if (first_bad < 0 || p < first_bad) {
