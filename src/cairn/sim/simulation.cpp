@@ -318,7 +318,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       const double M = P.mass[p];
       const Vec<D> V = P.velocity[p];
       const MatD stress = -P.volume0[p] * P.kirchhoff_stress[p].template block<D>();
-      stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+      stencil.for_each_force(stress, [&](std::int32_t node, double S, const Vec<D>& force) {
         const std::int32_t i = node + off;
         const double Sm = S * M;
         if (plain || mass_and_momentum) {
@@ -331,7 +331,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
           }
         }
         if (plain || forces) {
-          nodes_.force[i] += stress * G;
+          nodes_.force[i] += force;
           if (!plain && has_body_force) {
             const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
             nodes_.force[i] += fb;
@@ -419,9 +419,11 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
   particle_vec_.resize(particles_.n());
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
-    Vec<D> u = Vec<D>::Zero();
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { u += S * in[node + off]; });
-    particle_vec_[p] = u;
+    double u[D] = {};  // registers (see update_stresses)
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
+    });
+    particle_vec_[p] = Vec<D>(u);
   });
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
   scatter(cache_, [&](std::int32_t p, const auto& stencil) {
@@ -563,13 +565,16 @@ void Simulation<D>::update_particles(double dt) {
     constexpr bool full = decltype(full_tag)::value;
     return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
       const std::int32_t off = field_offset(p);
-      GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
+      double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
       stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
         const std::int32_t i = node + off;
-        g.Sv += S * v[i];
-        g.Sv_new += S * v_new[i];
-        if (full) g.Sv_full += S * v_full[i];
+        for (int a = 0; a < D; ++a) {
+          sv[a] += S * v[i][a];
+          sv_new[a] += S * v_new[i][a];
+          if (full) sv_full[a] += S * v_full[i][a];
+        }
       });
+      GridAtParticle<D> g{P.velocity[p], Vec<D>(sv), Vec<D>(sv_new), Vec<D>(sv_full), dt};
       if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
       Effective<D> e = scheme.effective(g);
       e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
@@ -599,7 +604,7 @@ void Simulation<D>::update_particles(double dt) {
 }
 
 template <int D>
-Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
+void Simulation<D>::update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
   double* state = particles_.n_state_per_particle
                       ? &particles_.state[p * static_cast<std::size_t>(particles_.n_state_per_particle)]
@@ -609,9 +614,11 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, dou
   point.tau_old = &particles_.kirchhoff_stress[p];
   point.cell_size = grid_.min_cell_size();
   point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
+  point.planar = D < 3;
   const Material& m = *materials_[particles_.material[p]];
-  if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
-  return m.update(point);
+  SymMat3& tau = particles_.kirchhoff_stress[p];
+  if (mode_ == Mode::plane_stress) tau = plane_stress_update(m, F, point);
+  else m.update_stress(point, tau);
 }
 
 template <int D>
@@ -624,18 +631,15 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   using MatD = Eigen::Matrix<double, D, D>;
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
-    MatD L_D = MatD::Zero();
-    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
-      L_D += grid_velocity[node + off] * G.transpose();
-    });
+    const MatD L_D = stencil.gradient_of(grid_velocity, off);
     const MatD dF_D = tensor_exp<D>(L_D * dt);
     Mat3& F = particles_.deformation_gradient[p];
     F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
     Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
     L.template topLeftCorner<D, D>() = L_D;
     dF.template topLeftCorner<D, D>() = dF_D;
-    const SymMat3 tau = stress_for(static_cast<std::size_t>(p), L, dF, dt);
-    particles_.kirchhoff_stress[p] = tau;
+    update_stress_of(static_cast<std::size_t>(p), L, dF, dt);
+    const SymMat3& tau = particles_.kirchhoff_stress[p];
     const double J = F.determinant();
     // One test for the common case: a sum is finite only if every term is.
     const char* bad = nullptr;

@@ -109,7 +109,8 @@ class Simulation {
  private:
   void setup_grid();
   void compute_body_forces();
-  Mat3 stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// The material's stress update of particle p into its stored stress (plane stress included).
+  void update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
   [[nodiscard]] double max_signal_speed() const;
   /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
   /// with conditions, or m~_k^-1 q for FMPM.
