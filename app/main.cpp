@@ -1,14 +1,16 @@
 // The `cairn` command: run, check, keys, restart.
 //
-// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found); 3 the simulation
-// failed (which particle, step, time and quantity), after writing its last good output;
-// 1 anything else (an I/O failure, an internal error).
+// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found) or a bad command
+// line; 3 the simulation failed (which particle, step, time and quantity), after writing its
+// last good output; 1 anything else (an I/O failure such as a full disk, an internal error).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
 
 #include <iostream>
+#include <new>
 
+#include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
@@ -33,6 +35,13 @@ void describe_setup(const cairn::Config& config) {
 }
 
 void describe(const cairn::Config& config) {
+  if (config.fem.enabled) {
+    const cairn::fem::Solver solver(config);
+    fmt::print("# fem mesh ({}): {} nodes, {} triangles\n", solver.mesh().source, solver.mesh().n_nodes(),
+               solver.mesh().n_elements());
+    fmt::print("# first time step: {:.6g}\n", solver.next_dt());
+    return;
+  }
   switch (config.simulation.dimension) {
     case 1: describe_setup<1>(config); break;
     case 2: describe_setup<2>(config); break;
@@ -41,11 +50,11 @@ void describe(const cairn::Config& config) {
 }
 
 void print_summary(const cairn::RunSummary& s) {
-  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} particle-steps/s with {} threads, "
-             "{} particles)\n",
-             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, omp_get_max_threads(),
-             s.n_particles);
-  fmt::print("cairn: output in {} (history.csv, particles.xdmf, snapshots/)\n", s.output_directory.string());
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {} threads, "
+             "{} {}s)\n",
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, omp_get_max_threads(),
+             s.n_particles, s.item);
+  fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;
   for (const auto& [name, sec] : s.stage_seconds) total += sec;
@@ -65,6 +74,13 @@ void print_summary(const cairn::RunSummary& s) {
   }
 }
 
+void print_warnings(const cairn::Config& config) {
+  for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
+}
+
+/// Largest -t: as simulation.threads (io/schema.cpp).
+constexpr int max_threads = 1024;
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -82,7 +98,8 @@ int main(int argc, char** argv) {
   run->add_option("input", input, "input file")->required();
   run->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
   run->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  run->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+  run->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+      ->check(CLI::Range(0, max_threads));
 
   auto* check = app.add_subcommand("check", "validate an input file and print the resolved settings");
   check->add_option("input", input, "input file")->required();
@@ -95,9 +112,15 @@ int main(int argc, char** argv) {
   restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
   restart->add_option("--set", overrides, "override an input key of the stored input");
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  restart->add_option("-t,--threads", threads, "OpenMP threads (default: all cores)");
+  restart->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+      ->check(CLI::Range(0, max_threads));
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help, the version or the error
+    return code == 0 ? 0 : 2;      // a bad command line is bad input
+  }
   if (threads > 0) omp_set_num_threads(threads);
 
   try {
@@ -107,6 +130,7 @@ int main(int argc, char** argv) {
     }
     if (*check) {
       const cairn::Config config = cairn::load_config(input, overrides);
+      print_warnings(config);
       std::cout << config.resolved_toml;
       describe(config);
       return 0;
@@ -116,6 +140,7 @@ int main(int argc, char** argv) {
     cairn::RunSummary summary;
     if (*run) {
       const cairn::Config config = cairn::load_config(input, overrides);
+      print_warnings(config);
       summary = cairn::run(config, options);
     } else {
       summary = cairn::restart(input, overrides, options);
@@ -134,6 +159,9 @@ int main(int argc, char** argv) {
   } catch (const cairn::RunFailure& e) {
     std::cerr << "cairn: " << e.what() << "\n";
     return 3;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "cairn: error: " << e.what() << "\n";
     return 1;

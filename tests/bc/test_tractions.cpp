@@ -9,6 +9,7 @@
 
 #include "cairn/bc/time_function.hpp"
 #include "cairn/bc/traction.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
@@ -118,7 +119,7 @@ TEST(Tractions, SelectionBySideBoxAndEveryExposedFace) {
             5u);
   EXPECT_THROW(faces("[[traction]]\nside = \"x_max\"\nbox_min = [0.0, 0.0]\nbox_max = [0.01, 0.01]\n"
                      "traction = [1.0, 0.0]\n"),
-               std::invalid_argument);  // selects no face: an input error
+               InputError);  // selects no face: file, line, key, expected, found
 }
 
 TEST(Tractions, FaceAreaFollowsTheDeformationWhereTheFamilyTracksIt) {

@@ -57,7 +57,7 @@ TEST(VelocityConditions, NodeSetsByFaceBoxAndPlane) {
   // A plane (2D: line) x = -1 intersected with a box.
   const auto plane = nodes("plane_axis = \"x\"\nplane_at = -1.0\nbox_min = [-5.0, 0.25]\nbox_max = [5.0, 5.0]\n");
   EXPECT_EQ(plane.size(), 7u + 2u);  // y = 0.25 ... 1.0 and the two ghost rows beyond
-  EXPECT_THROW(nodes("box_min = [0.01, 0.01]\nbox_max = [0.02, 0.02]\n"), std::invalid_argument);
+  EXPECT_THROW(nodes("box_min = [0.01, 0.01]\nbox_max = [0.02, 0.02]\n"), InputError);  // selects no node: file, line, key, expected, found
 }
 
 TEST(VelocityConditions, StepImposesStartAndEndValuesAndRecordsTheReaction) {

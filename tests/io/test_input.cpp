@@ -189,7 +189,7 @@ TEST(InputErrors, SetOfUnknownKey) {
   EXPECT_EQ(message(error_of(base, {"materail[0].density=1"})),
             "--set materail[0].density=1: key 'materail': expected a section, one of simulation, grid, "
             "method, constants, material, body, boundary, thermal, body_force, traction, velocity, wall, "
-            "contact, contact_pair, output (did you mean "
+            "contact, contact_pair, fem, output (did you mean "
             "'material'?); found an undeclared key");
   // The model decides the keys of a [[material]].
   EXPECT_EQ(message(error_of(base, {"material.0.form=\"ln_j\""})).rfind(

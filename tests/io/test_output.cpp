@@ -174,10 +174,14 @@ TEST(AtomicFile, WriteLeavesNoTempFile) {
   EXPECT_EQ(list_dir(target.parent_path()), std::vector<std::string>{"a.txt"});
 }
 
-TEST(AtomicFile, TempPathIsNextToTarget) {
-  const fs::path tmp = atomic_temp_path("/some/dir/file.h5");
-  EXPECT_EQ(tmp.parent_path(), fs::path("/some/dir"));
-  EXPECT_EQ(tmp.filename().string(), "file.h5.tmp." + std::to_string(::getpid()));
+TEST(AtomicFile, TempFileIsNewAndNextToTarget) {
+  TempDir dir;
+  const fs::path target = dir.path() / "file.h5";
+  const fs::path a = create_atomic_temp(target), b = create_atomic_temp(target);
+  EXPECT_EQ(a.parent_path(), dir.path());
+  EXPECT_EQ(a.filename().string().rfind("file.h5.tmp." + std::to_string(::getpid()) + ".", 0), 0u);
+  EXPECT_NE(a, b);
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(a)));
 }
 
 TEST(AtomicFile, ExceptionKeepsOldTarget) {

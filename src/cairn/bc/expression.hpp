@@ -27,9 +27,15 @@ using Constants = std::vector<std::pair<std::string, double>>;
 
 class Expression {
  public:
-  /// Throws std::invalid_argument with muParser's message on a syntax error or unknown name.
+  /// Throws std::invalid_argument with muParser's message on a syntax error or unknown name, and
+  /// for what muParser accepts but an input must not have: an assignment (`t=1e9`, `x+=1`) and
+  /// a ',' outside a function's arguments (`-9,81`, which muParser evaluates to 81).
   Expression(const std::string& text, const Constants& constants);
   ~Expression();
+  /// Compile `text` with the variables `variables` (for keys with their own, such as a contact
+  /// law's slide expression) and throw as the constructor does.
+  static void check(const std::string& text, const std::vector<std::string>& variables,
+                    const Constants& constants);
   Expression(const Expression&) = delete;
   Expression& operator=(const Expression&) = delete;
 
@@ -40,11 +46,14 @@ class Expression {
   /// True when the expression uses a position variable (x, y, z, X, Y or Z).
   [[nodiscard]] bool uses_position() const { return uses_position_; }
   [[nodiscard]] const std::string& text() const { return text_; }
+  /// The variables (x, y, z, X, Y, Z, t) the expression uses, in alphabetical order.
+  [[nodiscard]] const std::vector<std::string>& used_variables() const { return used_; }
 
  private:
   std::string text_;
   std::unique_ptr<mu::Parser> parser_;
   double x_ = 0, y_ = 0, z_ = 0, X_ = 0, Y_ = 0, Z_ = 0, t_ = 0;
+  std::vector<std::string> used_;
   bool constant_ = false;
   bool uses_x_ = false;
   bool uses_position_ = false;

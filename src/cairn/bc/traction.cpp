@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include "cairn/io/errors.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -77,7 +78,9 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
         }
     }
     if (load.n_faces == 0)
-      throw std::invalid_argument(what + " selects no exposed particle face (check body, side and box)");
+      throw InputError(tc.where.file, tc.where.line, "traction[" + std::to_string(k) + "]",
+                       "a selection (body, side, box_min/box_max) holding at least one exposed particle face",
+                       "traction '" + tc.name + "', which selects none");
     loads_.push_back(std::move(load));
   }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cairn/io/errors.hpp"
+
 namespace cairn {
 
 template <int D>
@@ -34,7 +36,11 @@ VelocityConditions<D>::VelocityConditions(const Config& config, const Grid<D>& g
         in = std::abs(x[vc.plane_axis] - vc.plane_at) <= 1e-6 * grid.cell_size()[vc.plane_axis];
       if (in) set.nodes.push_back(i);
     }
-    if (set.nodes.empty()) throw std::invalid_argument(what + " selects no grid node");
+    if (set.nodes.empty())
+      throw InputError(vc.where.file, vc.where.line,
+                       fmt::format("velocity[{}]", &vc - config.velocity_conditions.data()),
+                       "a selection (face, box_min/box_max, plane_axis/plane_at) holding at least one grid node",
+                       fmt::format("velocity condition '{}', which selects none", vc.name));
     sets_.push_back(std::move(set));
     names_.push_back(vc.name);
     kinds_.push_back("velocity condition");

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -85,6 +86,18 @@ class Grid {
 
   [[nodiscard]] Vec<D> node_position(std::int32_t idx) const {
     return origin_ + multi_index(idx).template cast<double>().cwiseProduct(h_);
+  }
+
+  /// Largest |xi| (cell units from the origin) a particle may have: the input allows at most
+  /// 1e9 cells per axis, and stencil cell and node indices computed from such xi stay far from
+  /// int overflow. Positions beyond it (or NaN) have left the grid whatever the axis.
+  static constexpr double max_cell_units = 1.5e9;
+  /// True when every |xi[a]| < max_cell_units, checked in floating point before any cell index
+  /// is formed (a restart position of 3e9 or 1e30 would otherwise wrap to a valid-looking cell).
+  [[nodiscard]] static bool indexable(const Vec<D>& xi) {
+    for (int a = 0; a < D; ++a)
+      if (!(std::abs(xi[a]) < max_cell_units)) return false;
+    return true;
   }
 
   /// Position in cell units relative to the origin: xi = (x - origin) / h.

@@ -1,8 +1,12 @@
 #include "cairn/io/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
-#include <fstream>
+#include <cerrno>
+#include <cstring>
+#include <random>
 #include <stdexcept>
 #include <system_error>
 
@@ -10,10 +14,42 @@ namespace cairn {
 
 namespace fs = std::filesystem;
 
-fs::path atomic_temp_path(const fs::path& target) {
-  fs::path tmp = target;
-  tmp += ".tmp." + std::to_string(static_cast<long long>(::getpid()));
-  return tmp;
+namespace {
+
+/// The system's reason for errno `e`, lower-case for a full disk so that messages read
+/// "...: no space left on device".
+std::string reason(int e) {
+  if (e == ENOSPC) return "no space left on device";
+  if (e == EDQUOT) return "disk quota exceeded";
+  return std::strerror(e);
+}
+
+/// True when the file system holding `dir` has no block left for an unprivileged writer.
+bool file_system_full(const fs::path& dir) {
+  struct statvfs st {};
+  return ::statvfs(dir.empty() ? "." : dir.c_str(), &st) == 0 && st.f_bavail == 0;
+}
+
+}  // namespace
+
+fs::path create_atomic_temp(const fs::path& target) {
+  std::random_device entropy;
+  const std::string stem = target.string() + ".tmp." + std::to_string(static_cast<long long>(::getpid())) + ".";
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path tmp = stem + std::to_string(entropy() % 1000000000u);
+    // O_EXCL: fails on any existing entry, a symbolic link (even a dangling one) included.
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      ::close(fd);
+      return tmp;
+    }
+    if (errno != EEXIST) {
+      const int e = errno;
+      throw std::runtime_error("cannot create a temporary file next to '" + target.string() + "': " + reason(e));
+    }
+  }
+  throw std::runtime_error("cannot create a temporary file next to '" + target.string() +
+                           "': 100 random names were all taken");
 }
 
 void write_file_atomically(const fs::path& target,
@@ -27,13 +63,23 @@ void write_file_atomically(const fs::path& target,
                                "' for output file '" + target.string() + "': " + ec.message());
     }
   }
-  const fs::path tmp = atomic_temp_path(target);
+  const fs::path tmp = create_atomic_temp(target);
   auto discard_tmp = [&tmp] {
     std::error_code ignored;
     fs::remove(tmp, ignored);
   };
+  errno = 0;
   try {
     writer(tmp);
+  } catch (const std::runtime_error& e) {
+    // Libraries (HDF5) report a failed write without errno; a full disk is worth saying.
+    const int err = errno;
+    const bool full = err == ENOSPC || err == EDQUOT || file_system_full(parent);
+    discard_tmp();
+    if (!full) throw;
+    const std::string why = reason(err == EDQUOT ? EDQUOT : ENOSPC);
+    if (std::string(e.what()).find(why) != std::string::npos) throw;
+    throw std::runtime_error("cannot write '" + target.string() + "': " + why + " (" + e.what() + ")");
   } catch (...) {
     discard_tmp();
     throw;
@@ -49,11 +95,31 @@ void write_file_atomically(const fs::path& target,
 
 void write_text_atomically(const fs::path& target, const std::string& text) {
   write_file_atomically(target, [&text, &target](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot open '" + tmp.string() + "' for writing (output file '" + target.string() + "')");
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.close();
-    if (!out) throw std::runtime_error("error while writing '" + target.string() + "'");
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) {
+      const int e = errno;
+      throw std::runtime_error("cannot open '" + tmp.string() + "' for writing (output file '" +
+                               target.string() + "'): " + reason(e));
+    }
+    const char* data = text.data();
+    std::size_t left = text.size();
+    while (left > 0) {
+      const ssize_t wrote = ::write(fd, data, left);
+      if (wrote < 0 && errno == EINTR) continue;
+      if (wrote <= 0) {
+        const int e = wrote < 0 ? errno : ENOSPC;
+        ::close(fd);
+        errno = e;
+        throw std::runtime_error("error while writing '" + target.string() + "': " + reason(e));
+      }
+      data += wrote;
+      left -= static_cast<std::size_t>(wrote);
+    }
+    if (::close(fd) != 0) {
+      const int e = errno;
+      errno = e;
+      throw std::runtime_error("error while writing '" + target.string() + "': " + reason(e));
+    }
   });
 }
 

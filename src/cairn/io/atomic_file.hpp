@@ -2,6 +2,11 @@
 // temporary file next to the target and then renamed over it, so a run that is interrupted
 // (signal, time limit, exception) never leaves a half-written output file behind. The rename is
 // atomic on POSIX file systems; no fsync is done, so a power loss may still lose recent data.
+//
+// The temporary file is created with O_CREAT | O_EXCL | O_NOFOLLOW under a name with a random
+// part, so a symbolic link planted in the output directory cannot redirect the write, and the
+// rename replaces a link at the target itself rather than the file it points to. A write that
+// fails because the file system is full says "no space left on device".
 #pragma once
 
 #include <filesystem>
@@ -10,18 +15,21 @@
 
 namespace cairn {
 
-/// Name of the temporary file used while writing `target`: `<target>.tmp.<pid>` in the same
-/// directory (the same file system, so the final rename is atomic).
-[[nodiscard]] std::filesystem::path atomic_temp_path(const std::filesystem::path& target);
+/// Create a new, empty temporary file `<target>.tmp.<pid>.<random>` next to `target` (the same
+/// file system, so the final rename is atomic), never following or reusing an existing entry.
+/// Throws std::runtime_error naming the directory if it cannot.
+[[nodiscard]] std::filesystem::path create_atomic_temp(const std::filesystem::path& target);
 
-/// Call `writer(tmp)` to produce the file at `tmp`, then rename `tmp` over `target`. Creates the
-/// parent directory of `target` if it is missing. If `writer` throws, or the rename fails, the
-/// temporary file is removed, `target` is left as it was, and the exception propagates.
+/// Call `writer(tmp)` to produce the file at `tmp` (created empty by create_atomic_temp), then
+/// rename `tmp` over `target`. Creates the parent directory of `target` if it is missing. If
+/// `writer` throws, or the rename fails, the temporary file is removed, `target` is left as it
+/// was, and the exception propagates (as a std::runtime_error saying "no space left on device"
+/// when the file system is full).
 void write_file_atomically(const std::filesystem::path& target,
                            const std::function<void(const std::filesystem::path& tmp)>& writer);
 
 /// Write `text` verbatim (binary mode, no newline translation) to `target` atomically.
-/// Throws std::runtime_error naming the file if it cannot be written.
+/// Throws std::runtime_error naming the file and the system's reason if it cannot be written.
 void write_text_atomically(const std::filesystem::path& target, const std::string& text);
 
 }  // namespace cairn

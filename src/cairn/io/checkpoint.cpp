@@ -6,6 +6,8 @@
 #include <system_error>
 
 #include "cairn/io/atomic_file.hpp"
+#include "cairn/io/checksum.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/io/hdf5_util.hpp"
 
 namespace cairn {
@@ -193,6 +195,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
       h5::write_ints(gid, "body", ps.body.data(), n);
       h5::write_doubles(gid, "state", ps.state.data(), ps.state.size());
     }
+    write_content_checksum(root);  // last: it covers everything above
   });
 }
 
@@ -205,6 +208,12 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
                                          path.string(), dimension, D));
   }
   const hid_t root = file.get();
+  if (std::string stored, computed; !content_checksum_matches(root, stored, computed))
+    throw InputError(path.string(), 0, "checksum",
+                     fmt::format("the content checksum stored when the checkpoint was written ({})", stored),
+                     fmt::format("content with checksum {}: the file was changed or damaged after it "
+                                 "was written, so it is refused",
+                                 computed));
   CheckpointData<D> data;
   data.time = h5::read_double_attribute(root, "time");
   data.step = h5::read_int64_attribute(root, "step");

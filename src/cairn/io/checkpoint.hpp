@@ -5,7 +5,8 @@
 // gives results identical to a run that was never interrupted. Files are written atomically.
 //
 // File layout (format "cairn-checkpoint", version 1):
-//   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index
+//   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index,
+//     checksum (io/checksum.hpp: over everything else; a mismatch is refused on reading)
 //   /config_toml                         scalar string
 //   /scalars/names, /scalars/values      run-loop scalars (string list, doubles)
 //   /history/columns, /history/rows      string list, rows x columns doubles

@@ -34,12 +34,17 @@ struct SimulationConfig {
   long long max_steps = 0;  ///< 0: no limit
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
+  double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
+  double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
+  std::string body_overlap = "error";  ///< bodies sharing space: error | warn
+  SourceLocation where;     ///< the [simulation] table (end_time's line when given)
 };
 
 struct GridConfig {
   std::vector<double> origin;     ///< D values
   std::vector<double> extent;     ///< D values: domain size
   std::vector<double> cell_size;  ///< D values (one given value is repeated)
+  SourceLocation where;           ///< of grid.cell_size
 };
 
 struct MethodConfig {
@@ -98,6 +103,7 @@ struct BodyConfig {
   std::vector<int> particles_per_cell;  ///< per direction, D values (one given value is repeated)
   std::vector<std::string> velocity;    ///< D expressions in X,Y,Z (numbers are expressions too)
   std::vector<std::string> displacement;  ///< D expressions in X,Y,Z; empty = none
+  bool clip = false;  ///< keep the part of the shape inside the grid; false: past the grid is an error
   SourceLocation where;
 };
 
@@ -198,6 +204,25 @@ struct ContactConfig {
   [[nodiscard]] bool enabled() const { return mode != "none"; }
 };
 
+/// [fem]: the reference explicit FEM of seed 001 Appendix A (docs/fem.md). When enabled the run
+/// has no grid and no particles: [grid] and [[body]] are absent and the mesh is the body.
+struct FemConfig {
+  bool enabled = false;
+  std::string material;             ///< name of a [[material]]
+  std::string mesh_file;            ///< Gmsh .msh file (absolute once loaded); "" = generate from shape
+  BodyShapeConfig shape;            ///< generated mesh: box | circle | ellipse | annulus | polygon
+  std::vector<double> hole_center;  ///< D values: circular hole cut from the shape; empty = none
+  double hole_radius = 0.0;
+  double size = 0.0;                ///< characteristic element size of generated meshes
+  std::string mesher = "gmsh";      ///< gmsh | structured
+  std::vector<std::string> velocity;      ///< D expressions in X,Y: initial velocity
+  std::vector<std::string> displacement;  ///< D expressions in X,Y; empty = none
+  /// D expressions in X,Y,t: an exact displacement; history.csv then gets the node error of
+  /// seed 001 Eq. 38 every step (displacement_error, and its maximum over all steps so far).
+  std::vector<std::string> exact_displacement;
+  SourceLocation where;
+};
+
 struct OutputConfig {
   std::string directory;        ///< default out/<input file stem>
   double every = 0.0;           ///< snapshot interval in time; 0 = first and last only
@@ -224,7 +249,11 @@ struct Config {
   std::vector<std::pair<std::string, double>> constants;  ///< [constants]: names usable in expressions
   ThermalConfig thermal;
   ContactConfig contact;
+  FemConfig fem;
   OutputConfig output;
+  /// Values that are valid but suspicious (e.g. a density of 1e308), one message each with file,
+  /// line and key; the CLI prints them.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace cairn

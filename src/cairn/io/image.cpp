@@ -92,6 +92,13 @@ GreyImage read_png_grey(const std::string& path) {
     std::fclose(fp);
     throw fail(state.message);
   }
+  // The header's size decides the allocation: refuse a claim beyond the limit before it.
+  if (static_cast<double>(width) * static_cast<double>(height) > static_cast<double>(max_image_pixels)) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    std::fclose(fp);
+    throw fail("its header claims " + std::to_string(width) + " x " + std::to_string(height) +
+               " pixels, more than the " + std::to_string(max_image_pixels) + " an image may have");
+  }
   const int channels = png_get_channels(png, info);
   const int depth = png_get_bit_depth(png, info);
   const std::size_t row_bytes = png_get_rowbytes(png, info);

@@ -29,8 +29,12 @@ struct GreyImage {
   }
 };
 
+/// Most pixels an image may have (2^28, 256 MiB of grey levels): a header claiming more is
+/// refused before anything is allocated.
+inline constexpr long long max_image_pixels = 1LL << 28;
+
 /// The image in `path` as 8-bit grey levels. Throws std::invalid_argument naming the path and
-/// the reason (cannot open, not a PNG file, libpng's error message) on failure.
+/// the reason (cannot open, not a PNG file, too many pixels, libpng's error message) on failure.
 GreyImage read_png_grey(const std::string& path);
 
 /// Where an image named in an input file lies: `file` itself when absolute, else `file` relative

@@ -21,6 +21,7 @@
 #include <optional>
 #include <sstream>
 
+#include "cairn/bc/expression.hpp"
 #include "cairn/io/image.hpp"
 #include "cairn/io/schema.hpp"
 #include "cairn/materials/material.hpp"
@@ -34,6 +35,21 @@ using Path = std::vector<std::string>;
 
 /// extent / cell_size must be this close (relative) to a whole number; quoted in the message.
 constexpr double ratio_tolerance = 1e-9;
+
+/// Input numbers beyond this magnitude (or nonzero below its inverse) get a warning.
+constexpr double max_magnitude = 1e30;
+
+/// Most cells along one grid axis (see Grid::max_cell_units: indices stay far from int overflow).
+constexpr long long max_cells_per_axis = 1000000000;
+
+/// The variables an expression key may use (checked when the input is read).
+enum class ExpressionVars {
+  initial,   ///< x, y, z, X, Y, Z up to the dimension: evaluated once, at t = 0 (body velocity)
+  field,     ///< positions and t (body force)
+  time,      ///< t only (time functions of loads, velocity conditions and walls)
+  slide,     ///< Nc, vslip, t: the general contact law's slide expression
+  unchecked, ///< read as text: the caller checks it (a wall gradient may be a word)
+};
 
 Path child(Path p, std::string part) {
   p.push_back(std::move(part));
@@ -270,10 +286,12 @@ class TableReader {
   /// n numbers; with allow_scalar one number stands for all n.
   [[nodiscard]] std::vector<double> reals(const std::string& name, std::size_t n, bool allow_scalar);
   [[nodiscard]] std::vector<int> integers(const std::string& name, std::size_t n, bool allow_scalar);
-  /// n entries, numbers or non-empty strings, as expression text; empty when absent.
-  [[nodiscard]] std::vector<std::string> expressions(const std::string& name, std::size_t n);
-  /// One number or non-empty expression string, as expression text.
-  [[nodiscard]] std::string expression(const std::string& name);
+  /// n entries, numbers or non-empty strings, as expression text; empty when absent. Each is
+  /// compiled and may use only the variables `vars` allows.
+  [[nodiscard]] std::vector<std::string> expressions(const std::string& name, std::size_t n,
+                                                     ExpressionVars vars);
+  /// One number or non-empty expression string, as expression text (checked as above).
+  [[nodiscard]] std::string expression(const std::string& name, ExpressionVars vars);
   /// At least min_count points of n coordinates each ([[x, y], ...]).
   [[nodiscard]] std::vector<std::vector<double>> points(const std::string& name, std::size_t n,
                                                         std::size_t min_count);
@@ -335,6 +353,12 @@ class Loader {
     throw InputError(where.file, where.line, display(path), expected, found);
   }
 
+  /// Record a warning about the value at `path` ("file:line: key 'k': what"); load() hands them
+  /// to Config::warnings.
+  void warn(const Path& path, const toml::node* node, const std::string& what) {
+    warnings_.push_back(fmt::format("{}: key '{}': {}", locate(path, node).str(), display(path), what));
+  }
+
   /// Parsed default value (kept alive for the loader's lifetime).
   const toml::node* default_node(const KeyDecl& decl) {
     defaults_.push_back(toml::parse("v = " + decl.default_value));
@@ -342,6 +366,12 @@ class Loader {
   }
 
   [[nodiscard]] int dimension() const { return dim_; }
+
+  /// Compile `text` (the value of the key at `path`) with the [constants] and check it: valid
+  /// syntax, no ',' between expressions, no assignment, only the variables `vars` allows, a
+  /// finite value when it uses no variable.
+  void check_expression(const Path& path, const toml::node* node, const std::string& text,
+                        ExpressionVars vars) const;
 
  private:
   void apply_override(toml::table& root, const std::string& text);
@@ -361,6 +391,8 @@ class Loader {
   void read_velocity_conditions(const toml::table& root, Config& cfg);
   void read_walls(const toml::table& root, Config& cfg);
   void read_contact(const toml::table& root, Config& cfg);
+  /// [fem] (docs/fem.md): a mesh instead of [grid] and [[body]]; rejects the MPM-only sections.
+  void read_fem(const toml::table& root, Config& cfg);
   /// box_min/box_max of a selection: both or neither, max >= min on every axis.
   void read_box(TableReader& r, std::vector<double>& lo, std::vector<double>& hi);
   TimeTable read_table(TableReader& r);
@@ -378,6 +410,8 @@ class Loader {
   std::vector<std::pair<Path, std::string>> overrides_;  ///< path -> "--set <text>"
   std::deque<toml::table> defaults_;
   std::vector<std::string> condition_names_;  ///< [[velocity]] and [[wall]] names (history columns)
+  Constants constants_;  ///< [constants], for compiling expressions
+  std::vector<std::string> warnings_;
   int dim_ = 0;
 };
 
@@ -431,6 +465,11 @@ double TableReader::number(const Value& v, const Path& path, const std::string& 
   else if (auto f = v.node->as_floating_point()) x = f->get();
   else loader_.fail(path, v.node, expected, found(v, true));
   if (!std::isfinite(x)) loader_.fail(path, v.node, expected + " (finite)", found(v, false));
+  if (!v.is_default && x != 0.0 && !(std::abs(x) <= max_magnitude && std::abs(x) >= 1.0 / max_magnitude))
+    loader_.warn(path, v.node,
+                 fmt::format("{} is beyond 1e{:.0f} in magnitude (or, nonzero, below 1e-{:.0f}), which no "
+                             "unit system needs; energies and stresses may overflow",
+                             node_text(*v.node), std::log10(max_magnitude), std::log10(max_magnitude)));
   return x;
 }
 
@@ -547,7 +586,8 @@ std::vector<int> TableReader::integers(const std::string& name, std::size_t n, b
   return out;
 }
 
-std::vector<std::string> TableReader::expressions(const std::string& name, std::size_t n) {
+std::vector<std::string> TableReader::expressions(const std::string& name, std::size_t n,
+                                                  ExpressionVars vars) {
   Value v = value(name);
   if (!v.node) return {};
   const std::string entry = "a number or a non-empty expression string";
@@ -561,6 +601,7 @@ std::vector<std::string> TableReader::expressions(const std::string& name, std::
     const Path p = child(path_of(name), i);
     if (auto s = e->as_string()) {
       if (trim(s->get()).empty()) loader_.fail(p, e, entry, "an empty string");
+      loader_.check_expression(p, e, s->get(), vars);
       out.push_back(s->get());
     } else if (e->is_number()) {
       out.push_back(expression_number(number(Value{e, v.is_default, v.decl}, p, entry)));
@@ -571,11 +612,12 @@ std::vector<std::string> TableReader::expressions(const std::string& name, std::
   return out;
 }
 
-std::string TableReader::expression(const std::string& name) {
+std::string TableReader::expression(const std::string& name, ExpressionVars vars) {
   Value v = required_value(name);
   const std::string expected = expected_value_text(*v.decl);
   if (auto s = v.node->as_string()) {
     if (trim(s->get()).empty()) fail(name, v.node, expected, "an empty string");
+    loader_.check_expression(path_of(name), v.node, s->get(), vars);
     return s->get();
   }
   if (v.node->is_number()) return expression_number(number(v, path_of(name), expected));
@@ -606,6 +648,50 @@ std::vector<std::vector<double>> TableReader::points(const std::string& name, st
     out.push_back(std::move(xs));
   }
   return out;
+}
+
+// ---- expressions ---------------------------------------------------------------------------
+
+void Loader::check_expression(const Path& path, const toml::node* node, const std::string& text,
+                              ExpressionVars vars) const {
+  if (vars == ExpressionVars::unchecked) return;
+  if (vars == ExpressionVars::slide) {
+    const std::vector<std::string> slide_vars{"Nc", "vslip", "t"};
+    try {
+      Expression::check(text, slide_vars, constants_);
+    } catch (const std::invalid_argument& err) {
+      fail(path, node, "one expression in Nc, vslip, t and [constants]", err.what());
+    }
+    return;
+  }
+  std::vector<std::string> allowed;
+  if (vars != ExpressionVars::time) {
+    for (int a = 0; a < dim_; ++a) allowed.emplace_back(1, "xyz"[a]);
+    for (int a = 0; a < dim_; ++a) allowed.emplace_back(1, "XYZ"[a]);
+  }
+  if (vars != ExpressionVars::initial) allowed.emplace_back("t");
+  std::string expected = fmt::format("one expression in {} and [constants]", join(allowed));
+  if (vars == ExpressionVars::initial) expected += " (evaluated once, at t = 0)";
+  std::unique_ptr<Expression> e;
+  try {
+    e = std::make_unique<Expression>(text, constants_);
+  } catch (const std::invalid_argument& err) {
+    fail(path, node, expected, err.what());
+  }
+  for (const auto& v : e->used_variables()) {
+    if (std::find(allowed.begin(), allowed.end(), v) != allowed.end()) continue;
+    std::string why;
+    if (v == "t") why = "an initial value does not depend on time";
+    else if (vars == ExpressionVars::time) why = "a function of time has no position";
+    else why = fmt::format("a {}D input has no {} axis", dim_, v);
+    fail(path, node, expected, fmt::format("{}, which uses {} ({})", toml_string(text), v, why));
+  }
+  if (e->is_constant()) {
+    const double value = (*e)(Vec3::Zero(), Vec3::Zero(), 0.0);
+    if (!std::isfinite(value))
+      fail(path, node, expected + " with a finite value",
+           fmt::format("{} = {}", toml_string(text), value));
+  }
 }
 
 // ---- overrides -----------------------------------------------------------------------------
@@ -811,6 +897,10 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
+  s.memory_limit = r.real("memory_limit");
+  s.max_estimated_steps = r.real("max_estimated_steps");
+  s.body_overlap = r.string("body_overlap");
+  s.where = locate(r.path_of("end_time"), r.given("end_time") ? r.given("end_time") : section(root, "simulation"));
 }
 
 void Loader::read_grid(const toml::table& root, Config& cfg) {
@@ -821,6 +911,26 @@ void Loader::read_grid(const toml::table& root, Config& cfg) {
   g.origin = r.reals("origin", n, false);
   g.extent = r.reals("extent", n, false);
   g.cell_size = r.reals("cell_size", n, true);
+  g.where = locate(r.path_of("cell_size"), r.given("cell_size") ? r.given("cell_size") : section(root, "grid"));
+  // Node and cell counts in floating point (no overflow), against the 32-bit node index of
+  // grid/grid.hpp; Simulation checks the stored nodes again with the shape's ghost layers.
+  double nodes = 1.0;
+  std::string counts;
+  for (std::size_t a = 0; a < n; ++a) {
+    const double cells = g.extent[a] / g.cell_size[a];
+    if (!(cells <= static_cast<double>(max_cells_per_axis)))
+      r.fail("cell_size", r.given("cell_size"),
+             fmt::format("at most {} cells along an axis (grid node indices are 32-bit integers)",
+                         max_cells_per_axis),
+             fmt::format("{} / {} = {:.6g} cells on axis {}", real_text(g.extent[a]),
+                         real_text(g.cell_size[a]), cells, "xyz"[a]));
+    nodes *= std::round(cells) + 1.0;
+    counts += fmt::format("{}{:.0f}", a ? " x " : "", std::round(cells));
+  }
+  if (nodes > static_cast<double>(INT32_MAX))
+    r.fail("cell_size", r.given("cell_size"),
+           fmt::format("at most {} grid nodes in all (grid node indices are 32-bit integers)", INT32_MAX),
+           fmt::format("{} cells = {:.6g} nodes", counts, nodes));
   for (std::size_t a = 0; a < n; ++a) {
     const double cells = g.extent[a] / g.cell_size[a];
     const double whole = std::round(cells);
@@ -880,6 +990,7 @@ void Loader::read_constants(const toml::table& root, Config& cfg) {
     if (!std::isfinite(x)) fail(p, node, "a finite number", node_text(*node));
     cfg.constants.emplace_back(name, x);
   }
+  constants_ = cfg.constants;
 }
 
 void Loader::read_materials(const toml::table& root, Config& cfg) {
@@ -1079,9 +1190,10 @@ void Loader::read_bodies(const toml::table& root, Config& cfg) {
              toml_string(b.material));
     b.shape = read_shape(r, cfg.bodies);
     b.particles_per_cell = r.integers("particles_per_cell", n, true);
-    b.velocity = r.expressions("velocity", n);
+    b.velocity = r.expressions("velocity", n, ExpressionVars::initial);
     if (b.velocity.empty()) b.velocity.assign(n, "0");
-    b.displacement = r.expressions("displacement", n);
+    b.displacement = r.expressions("displacement", n, ExpressionVars::initial);
+    b.clip = r.boolean("clip");
     b.where = {file_, line_of(t)};
     cfg.bodies.push_back(std::move(b));
   }
@@ -1149,7 +1261,8 @@ void Loader::read_body_force(const toml::table& root, Config& cfg) {
   TableReader r(*this, section(root, "body_force"), {"body_force"}, copy_section("body_force"),
                 "[body_force]");
   r.reject_unknown_keys();
-  cfg.body_force.expression = r.expressions("expression", static_cast<std::size_t>(dim_));
+  cfg.body_force.expression = r.expressions("expression", static_cast<std::size_t>(dim_),
+                                            ExpressionVars::field);
 }
 
 std::string Loader::entry_name(TableReader& r, const std::string& prefix, std::size_t index,
@@ -1233,7 +1346,7 @@ void Loader::read_tractions(const toml::table& root, Config& cfg) {
     if (c.side < 0 && c.box_min.empty())
       fail(path, t, "side, or box_min and box_max, to select the loaded faces", "neither");
     c.traction = r.reals("traction", n, false);
-    c.scale = r.expression("scale");
+    c.scale = r.expression("scale", ExpressionVars::time);
     c.table = read_table(r);
     c.where = {file_, line_of(t)};
     cfg.tractions.push_back(std::move(c));
@@ -1282,7 +1395,7 @@ void Loader::read_velocity_conditions(const toml::table& root, Config& cfg) {
     for (double d : c.direction) norm += d * d;
     if (!(norm > 0.0)) r.fail("direction", r.given("direction"), "a non-zero direction", "all zeros");
     for (double& d : c.direction) d /= std::sqrt(norm);
-    c.velocity = r.expression("velocity");
+    c.velocity = r.expression("velocity", ExpressionVars::time);
     c.table = read_table(r);
     c.where = {file_, line_of(t)};
     cfg.velocity_conditions.push_back(std::move(c));
@@ -1314,14 +1427,15 @@ void Loader::read_walls(const toml::table& root, Config& cfg) {
       r.fail("position", r.given("position"),
              fmt::format("a wall position inside the grid along {}, in [{}, {}]", axis, real_text(lo), real_text(hi)),
              real_text(c.position));
-    c.velocity = r.expression("velocity");
+    c.velocity = r.expression("velocity", ExpressionVars::time);
     c.table = read_table(r);
-    const std::string gradient = r.expression("gradient");
+    const std::string gradient = r.expression("gradient", ExpressionVars::unchecked);
     if (gradient == "zero") {
       c.gradient = WallGradient::zero;
     } else if (gradient == "estimate") {
       c.gradient = WallGradient::estimate;
     } else {
+      check_expression(r.path_of("gradient"), r.given("gradient"), gradient, ExpressionVars::time);
       c.gradient = WallGradient::given;
       c.gradient_expression = gradient;
     }
@@ -1329,6 +1443,73 @@ void Loader::read_walls(const toml::table& root, Config& cfg) {
     c.where = {file_, line_of(t)};
     cfg.walls.push_back(std::move(c));
   }
+}
+
+void Loader::read_fem(const toml::table& root, Config& cfg) {
+  // An FEM run has no grid and no particles: the sections that describe them, or features the
+  // FEM does not implement, are errors rather than silently ignored.
+  for (const char* other : {"grid", "method", "body", "traction", "wall", "contact", "contact_pair", "thermal"})
+    if (const toml::node* node = root.get(other))
+      fail({other}, node,
+           fmt::format("no [{}] in an FEM run ([fem] meshes the body; docs/fem.md lists what the FEM "
+                       "supports)", other),
+           fmt::format("[{}]", other));
+  const toml::table* t = section(root, "fem");
+  if (!t) fail({"fem"}, root.get("fem"), "a table, written [fem]", typed_text(*root.get("fem")));
+  TableReader r(*this, t, {"fem"}, copy_section("fem"), "[fem]");
+  r.reject_unknown_keys();
+  if (dim_ != 2)
+    fail({"simulation", "dimension"}, nullptr, "dimension = 2 for an FEM run (linear triangles)",
+         fmt::format("{}", dim_));
+  auto& f = cfg.fem;
+  f.enabled = true;
+  f.where = {file_, line_of(t)};
+  std::vector<std::string> material_names;
+  for (const auto& m : cfg.materials) material_names.push_back(m.name);
+  f.material = r.string("material");
+  if (std::find(material_names.begin(), material_names.end(), f.material) == material_names.end())
+    r.fail("material", r.given("material"),
+           material_names.empty() ? std::string("the name of a [[material]] (the input has none)")
+                                  : "the name of a [[material]], one of " + join(material_names) +
+                                        did_you_mean(f.material, material_names),
+           toml_string(f.material));
+  const auto n = static_cast<std::size_t>(dim_);
+  const std::string file = r.string("mesh_file");
+  if (file.empty() == !r.present("shape"))
+    fail({"fem"}, t, "exactly one of fem.mesh_file (a Gmsh .msh file) and fem.shape (a generated mesh)",
+         file.empty() ? "neither" : "both");
+  if (!file.empty()) {
+    f.mesh_file = resolve_input_relative(file, file_);
+  } else {
+    f.shape = read_shape(r, {});
+    if (f.shape.kind == "image")
+      r.fail("shape", r.given("shape"), "a shape the mesher can generate: box, circle, ellipse, annulus or polygon",
+             "image");
+  }
+  f.hole_radius = r.real("hole_radius");
+  if (f.hole_radius > 0.0) {
+    if (!file.empty()) r.fail("hole_radius", r.given("hole_radius"), "no hole with a mesh_file (the file is the mesh)",
+                              real_text(f.hole_radius));
+    f.hole_center = r.reals("hole_center", n, false);
+  } else if (r.present("hole_center")) {
+    r.fail("hole_center", r.given("hole_center"), "hole_radius > 0 with hole_center", "hole_radius = 0");
+  }
+  f.size = r.real("size");
+  if (file.empty() && !(f.size > 0.0))
+    r.fail("size", r.given("size"), "an element size > 0 for a generated mesh", real_text(f.size));
+  f.mesher = r.string("mesher");
+  if (f.mesher == "structured" && file.empty() && f.shape.kind != "box" && f.shape.kind != "annulus")
+    r.fail("mesher", r.given("mesher"), "\"gmsh\" for a " + f.shape.kind +
+           " (the structured mesher makes boxes and annuli)", toml_string(f.mesher));
+  if (f.mesher == "structured" && f.hole_radius > 0.0)
+    r.fail("mesher", r.given("mesher"), "\"gmsh\" for a shape with a hole", toml_string(f.mesher));
+  f.velocity = r.expressions("velocity", n, ExpressionVars::initial);
+  if (f.velocity.empty()) f.velocity.assign(n, "0");
+  f.displacement = r.expressions("displacement", n, ExpressionVars::initial);
+  f.exact_displacement = r.expressions("exact_displacement", n, ExpressionVars::field);
+  for (int face = 0; face < 2 * dim_; ++face)
+    if (cfg.boundary.face[face] == FaceCondition::periodic)
+      fail({"boundary", face_names[face]}, nullptr, "fixed, symmetry or free in an FEM run", "\"periodic\"");
 }
 
 void Loader::read_output(const toml::table& root, Config& cfg) {
@@ -1365,7 +1546,7 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
     law.law = lr.string("law");
     law.friction = lr.real("friction");
     law.dynamic_friction = lr.real("dynamic_friction");
-    law.slide = lr.expression("slide");
+    law.slide = lr.expression("slide", ExpressionVars::slide);
     return law;
   };
   c.law = read_law(r);
@@ -1423,12 +1604,14 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   Config cfg;
   cfg.source_file = file_;
   read_simulation(root, cfg);
-  read_grid(root, cfg);
+  const bool fem = root.contains("fem");
+  if (!fem) read_grid(root, cfg);
   read_method(root, cfg);
   read_constants(root, cfg);
   read_materials(root, cfg);
-  read_bodies(root, cfg);
+  if (!fem) read_bodies(root, cfg);
   read_boundary(root, cfg);
+  if (fem) read_fem(root, cfg);
   read_body_force(root, cfg);
   read_thermal(root, cfg);
   read_tractions(root, cfg);
@@ -1437,6 +1620,7 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
   read_contact(root, cfg);
   read_output(root, cfg);
   cfg.resolved_toml = config_to_toml(cfg);
+  cfg.warnings = std::move(warnings_);
   return cfg;
 }
 
@@ -1497,27 +1681,32 @@ std::string config_to_toml(const Config& c) {
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
+  line("memory_limit", real_text(s.memory_limit));
+  line("max_estimated_steps", real_text(s.max_estimated_steps));
+  line("body_overlap", toml_string(s.body_overlap));
 
-  o += "\n[grid]\n";
-  line("origin", reals_text(c.grid.origin));
-  line("extent", reals_text(c.grid.extent));
-  line("cell_size", reals_text(c.grid.cell_size));
+  if (!c.fem.enabled) {
+    o += "\n[grid]\n";
+    line("origin", reals_text(c.grid.origin));
+    line("extent", reals_text(c.grid.extent));
+    line("cell_size", reals_text(c.grid.cell_size));
 
-  const auto& m = c.method;
-  o += "\n[method]\n";
-  line("shape", toml_string(m.shape));
-  line("update", toml_string(m.update));
-  line("order", fmt::format("{}", m.order));
-  line("stress_update", toml_string(m.stress_update));
-  line("smoothing_length", real_text(m.smoothing_length));
-  line("cpdi_max_span", real_text(m.cpdi_max_span));
-  line("beta", real_text(m.beta));
-  line("blend_position", toml_string(m.blend_position));
-  line("grid_damping", real_text(m.grid_damping));
-  line("particle_damping", real_text(m.particle_damping));
-  line("full_mass_cfl", real_text(m.full_mass_cfl));
-  line("velocity_bc_method", toml_string(m.velocity_bc_method));
-  line("time_integration", toml_string(m.time_integration));
+    const auto& m = c.method;
+    o += "\n[method]\n";
+    line("shape", toml_string(m.shape));
+    line("update", toml_string(m.update));
+    line("order", fmt::format("{}", m.order));
+    line("stress_update", toml_string(m.stress_update));
+    line("smoothing_length", real_text(m.smoothing_length));
+    line("cpdi_max_span", real_text(m.cpdi_max_span));
+    line("beta", real_text(m.beta));
+    line("blend_position", toml_string(m.blend_position));
+    line("grid_damping", real_text(m.grid_damping));
+    line("particle_damping", real_text(m.particle_damping));
+    line("full_mass_cfl", real_text(m.full_mass_cfl));
+    line("velocity_bc_method", toml_string(m.velocity_bc_method));
+    line("time_integration", toml_string(m.time_integration));
+  }
 
   if (!c.constants.empty()) {
     o += "\n[constants]\n";
@@ -1554,6 +1743,24 @@ std::string config_to_toml(const Config& c) {
     line("particles_per_cell", array_text(b.particles_per_cell, [](int n) { return fmt::format("{}", n); }));
     line("velocity", array_text(b.velocity, expression_text));
     if (!b.displacement.empty()) line("displacement", array_text(b.displacement, expression_text));
+    if (b.clip) line("clip", "true");
+  }
+  if (c.fem.enabled) {
+    const auto& f = c.fem;
+    o += "\n[fem]\n";
+    line("material", toml_string(f.material));
+    if (!f.mesh_file.empty()) line("mesh_file", toml_string(f.mesh_file));
+    else line("shape", shape_text(f.shape));
+    if (f.hole_radius > 0.0) {
+      line("hole_center", reals_text(f.hole_center));
+      line("hole_radius", real_text(f.hole_radius));
+    }
+    line("size", real_text(f.size));
+    line("mesher", toml_string(f.mesher));
+    line("velocity", array_text(f.velocity, expression_text));
+    if (!f.displacement.empty()) line("displacement", array_text(f.displacement, expression_text));
+    if (!f.exact_displacement.empty())
+      line("exact_displacement", array_text(f.exact_displacement, expression_text));
   }
 
   o += "\n[boundary]\n";
@@ -1562,14 +1769,16 @@ std::string config_to_toml(const Config& c) {
   line("acceleration", toml_string(c.boundary.acceleration == BoundaryAcceleration::zero ? "zero"
                                                                                   : "velocity_change"));
 
-  o += "\n[thermal]\n";
-  line("conduction", boolean(c.thermal.conduction));
-  for (int f = 0; f < 2 * s.dimension && f < 6; ++f) {
-    const ThermalFace tf = c.thermal.face[f];
-    line(face_names[f], toml_string(tf == ThermalFace::temperature ? "temperature"
-                                    : tf == ThermalFace::flux      ? "flux"
-                                                                   : "adiabatic"));
-    line(std::string(face_names[f]) + "_value", real_text(c.thermal.value[f]));
+  if (!c.fem.enabled) {
+    o += "\n[thermal]\n";
+    line("conduction", boolean(c.thermal.conduction));
+    for (int f = 0; f < 2 * s.dimension && f < 6; ++f) {
+      const ThermalFace tf = c.thermal.face[f];
+      line(face_names[f], toml_string(tf == ThermalFace::temperature ? "temperature"
+                                      : tf == ThermalFace::flux      ? "flux"
+                                                                     : "adiabatic"));
+      line(std::string(face_names[f]) + "_value", real_text(c.thermal.value[f]));
+    }
   }
 
   if (!c.body_force.expression.empty()) {
@@ -1627,7 +1836,7 @@ std::string config_to_toml(const Config& c) {
   }
 
   const auto& out = c.output;
-  {
+  if (!c.fem.enabled) {
     const ContactConfig& ct = c.contact;
     auto law_lines = [&](const ContactLawConfig& law) {
       line("law", toml_string(law.law));

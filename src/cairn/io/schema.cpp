@@ -94,9 +94,28 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("1.0")
                 .min(above_zero));
   k.push_back(Key("simulation", "threads", T::integer,
-                 "OpenMP threads; 0 = the OpenMP default.")
+                 "OpenMP threads, at most 1024; 0 = the command line's -t, else the OpenMP "
+                 "default (OMP_NUM_THREADS or all cores).")
                 .by_default("0")
-                .min(0));
+                .min(0)
+                .max(1024));
+  k.push_back(Key("simulation", "memory_limit", T::real,
+                 "GiB of memory the setup may need (grid nodes, particles, transfer caches, "
+                 "estimated before anything is allocated); 0 = the machine's memory (its cgroup "
+                 "limit when lower). A larger estimate is refused, naming the keys that drive it.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("simulation", "max_estimated_steps", T::real,
+                 "Refuse a run whose end_time / first time step exceeds this (a run that would "
+                 "never end), naming the material that sets the step; 0 = no check. Not checked "
+                 "when max_steps > 0.")
+                .by_default("1e8")
+                .min(0.0));
+  k.push_back(Key("simulation", "body_overlap", T::string,
+                 "Bodies whose shapes share space (their mass counts twice there): error refuses "
+                 "the input, warn prints a warning naming both and runs.")
+                .by_default("\"error\"")
+                .choices([] { return std::vector<std::string>{"error", "warn"}; }));
 
   // [grid]
   k.push_back(Key("grid", "origin", T::real_array,
@@ -212,10 +231,14 @@ std::vector<KeyDecl> make_declarations() {
                 .max(16));
   k.push_back(Key("body", "velocity", T::expression_array,
                  "Initial velocity, one entry per axis: numbers or expressions in X, Y, Z "
-                 "(reference position) and [constants]; default zeros."));
+                 "(reference position) and [constants], evaluated once (no t); default zeros."));
   k.push_back(Key("body", "displacement", T::expression_array,
                  "Initial displacement field, entries as for velocity (F is set from its "
                  "gradient); default none."));
+  k.push_back(Key("body", "clip", T::boolean,
+                 "Keep only the part of the shape inside the grid; false: a shape reaching past "
+                 "the grid (by half a particle spacing or more) is an error.")
+                .by_default("false"));
 
   // [[body]] shape kinds
   k.push_back(Key("body.shape.box", "min", T::real_array,
@@ -481,6 +504,43 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("1.0")
                 .min(above_zero));
 
+  // [fem] (docs/fem.md, seed 001 Appendix A)
+  k.push_back(Key("fem", "material", T::string,
+                 "Name of the [[material]] of the meshed body.")
+                .required());
+  k.push_back(Key("fem", "mesh_file", T::string,
+                 "Gmsh .msh file (relative to the input file) read through the Gmsh API; its "
+                 "3-node triangles are the mesh. Give either mesh_file or shape.")
+                .by_default("\"\""));
+  k.push_back(Key("fem", "shape", T::table,
+                 "Generated mesh: an inline table with one shape kind as in [[body]] (box, circle, "
+                 "ellipse, annulus, polygon)."));
+  k.push_back(Key("fem", "hole_center", T::real_array,
+                 "Centre of a circular hole cut from the generated shape (plate with a hole)."));
+  k.push_back(Key("fem", "hole_radius", T::real,
+                 "Radius of the hole; 0 = no hole.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("fem", "size", T::real,
+                 "Characteristic element size (edge length) of a generated mesh; halve it for the "
+                 "next mesh of a refinement sequence.")
+                .by_default("0.0")
+                .min(0.0));
+  k.push_back(Key("fem", "mesher", T::string,
+                 "gmsh: unstructured Frontal-Delaunay triangles from the Gmsh API; structured: a "
+                 "mapped mesh (boxes: crossed-diagonal quads; annuli: polar quads split in two).")
+                .by_default("\"gmsh\"")
+                .choices([] { return std::vector<std::string>{"gmsh", "structured"}; }));
+  k.push_back(Key("fem", "velocity", T::expression_array,
+                 "Initial node velocity, one entry per axis: numbers or expressions in X, Y "
+                 "(reference position) and [constants]; default zeros."));
+  k.push_back(Key("fem", "displacement", T::expression_array,
+                 "Initial node displacement, entries as for velocity; default none."));
+  k.push_back(Key("fem", "exact_displacement", T::expression_array,
+                 "Exact displacement u(X, Y, t) of a manufactured solution; history.csv then has "
+                 "displacement_error (max over nodes of |x - X - u|, seed 001 Eq. 38, every step) and "
+                 "displacement_error_max (its maximum over all steps so far); default none."));
+
   // [output]
   k.push_back(Key("output", "directory", T::string,
                  "Output folder; \"\" = out/<input file stem>.")
@@ -707,6 +767,18 @@ const std::vector<SectionDoc>& section_docs() {
        "first = \"steel\"\n"
        "second = \"rock\"\n"
        "law = \"perfect\"\n"},
+      {"fem", "[fem]",
+       "The reference explicit FEM of seed 001 Appendix A on linear triangles (docs/fem.md). With "
+       "[fem] the run has no grid and no particles: no [grid], [[body]], [[traction]], [[wall]], "
+       "[contact] or [thermal]. [boundary] faces apply to the nodes on the faces of the mesh's "
+       "bounding box, [[velocity]] selects nodes by face, box or plane, [body_force] acts on the "
+       "nodes (expressions of X, Y, x, y, t).",
+       "[fem]\n"
+       "material = \"steel\"\n"
+       "shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\n"
+       "hole_center = [0.0, 0.0]\n"
+       "hole_radius = 0.5\n"
+       "size = 0.02\n"},
       {"output", "[output]",
        "What is written, where and how often.",
        "[output]\n"
@@ -784,7 +856,20 @@ std::string markdown_text() {
       "- `D` is `simulation.dimension`; `real[D]` is an array with one number per axis.\n"
       "- Integers are accepted wherever a real is expected.\n"
       "- `expr[D]` entries are numbers or expression strings such as `\"A*sin(2*_pi*X)\"`; "
-      "they may use the names of `[constants]`. An empty string is an error.\n"
+      "they may use the names of `[constants]`. An empty string is an error. Each is checked "
+      "when the input is read: one expression (a `,` outside a function's arguments, as in "
+      "`\"-9,81\"`, is an error), no assignment (`=`, `+=`, ...), only the variables its key "
+      "allows: initial values (`[[body]]` velocity and displacement) the positions `x y z X Y Z` "
+      "up to the dimension but not `t`; time functions (traction scale, `[[velocity]]` and "
+      "`[[wall]]` velocity and gradient) only `t`; the body force both.\n"
+      "- A number beyond 1e30 in magnitude (or nonzero below 1e-30) is accepted with a warning: "
+      "no unit system needs it, and energies or stresses may overflow.\n"
+      "- Before anything is allocated, the grid's node count is checked against the 32-bit node "
+      "index (at most 1e9 cells per axis), and the memory of grid, particles and transfer caches "
+      "is estimated against `simulation.memory_limit`; a run whose `end_time` / first time step "
+      "exceeds `simulation.max_estimated_steps` is refused naming what sets the step. A body must "
+      "lie inside the grid (`clip = true` keeps the part inside) and may not share space with "
+      "another (`simulation.body_overlap`). docs/robustness.md lists every guard.\n"
       "- Any key can be overridden on the command line: `cairn run case.toml --set "
       "method.order=4 --set material[0].density=1100`. The value is read as a TOML value "
       "(`--set grid.origin=[0,0]`), or as a plain string when it is not one "
@@ -792,6 +877,9 @@ std::string markdown_text() {
       "their index from 0: `material.0.density` or `material[0].density`.\n"
       "- `cairn check case.toml` validates an input and prints it with every default filled "
       "in.\n"
+      "- Exit codes of `cairn`: 0 success; 2 bad input (this page's errors, a bad command line, "
+      "a damaged or edited checkpoint); 3 the simulation failed; 1 any other error (a full disk "
+      "says \"no space left on device\").\n"
       "\n"
       "Sections: ";
   std::vector<std::string> links;
@@ -941,7 +1029,7 @@ const std::vector<std::string>& section_names() {
                                               "constants",  "material", "body",
                                               "boundary",   "thermal",    "body_force", "traction",
                                               "velocity",   "wall",       "contact",    "contact_pair",
-                                              "output"};
+                                              "fem",        "output"};
   return names;
 }
 

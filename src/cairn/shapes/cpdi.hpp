@@ -248,6 +248,11 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     }
 #pragma omp for schedule(static)
     for (std::int64_t p = 0; p < n; ++p) {
+      if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
+        bad_t = std::min<std::int64_t>(bad_t, p);
+        cache.count[p] = 0;
+        continue;
+      }
       const Domain dom = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span);
       IVec<D> cell;
       for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(dom.xi[a]));
@@ -384,7 +389,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   if (first_bad != INT64_MAX) {
     const Vec<D>& x = particles.position[first_bad];
     std::string where;
-    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + failure_number(x[a]);
     throw SimulationFailure(first_bad, "position",
                             "particle " + std::to_string(first_bad) + " left the grid at (" +
                                 where + "): its CPDI domain reaches beyond the ghost nodes");

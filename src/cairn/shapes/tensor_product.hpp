@@ -53,6 +53,12 @@ void build_factored(const Kernel& kernel, const Grid<D>& grid, const Particles<D
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * W];
       double* value_out = &cache.axis_value[static_cast<std::size_t>(p) * D * 2 * W];
+      if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
+        bad_t = std::min<std::int64_t>(bad_t, p);
+        std::fill(node_out, node_out + D * W, 0);
+        std::fill(value_out, value_out + D * 2 * W, 0.0);
+        continue;
+      }
       for (int a = 0; a < D; ++a) {
         double w[W] = {}, dw[W] = {};  // a kernel may leave them unset outside its domain
         const int first = kernel.eval(particles, p, a, xi[a], w, dw);
@@ -108,6 +114,11 @@ void build_expanded(const Kernel& kernel, int width, const Grid<D>& grid, const 
       std::array<std::array<double, max_width>, D> w{}, dw{};
       IVec<D> first;
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
+        bad_t = std::min<std::int64_t>(bad_t, p);
+        cache.count[p] = 0;
+        continue;
+      }
       IVec<D> cell;
       for (int a = 0; a < D; ++a) {
         cell[a] = static_cast<int>(std::floor(xi[a]));
@@ -196,7 +207,7 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
   if (first_bad != INT64_MAX) {
     const Vec<D>& x = particles.position[first_bad];
     std::string where;
-    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + failure_number(x[a]);
     throw SimulationFailure(first_bad, "position",
                             "particle " + std::to_string(first_bad) + " left the grid at (" +
                                 where + "): its stencil reaches beyond the ghost nodes");

@@ -10,12 +10,23 @@
 // highest y; positions outside the picture are outside the body. A position on a pixel edge
 // (to 1e-6 pixel, so that rounding does not decide) belongs to the pixel on its +x / +y side:
 // lattices whose points fall on pixel corners sample the picture consistently.
+//
+// Only the lattice points inside the shape's bounds are visited (sim/resources.hpp), in the same
+// order as a sweep of the whole grid would visit them. A shape reaching past the grid is an error
+// unless the body says clip = true; bodies sharing space (a particle of one inside another's
+// shape) are an error or a warning by simulation.body_overlap.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/io/image.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {
@@ -70,6 +81,41 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
   return false;
 }
 
+/// Bodies sharing space: a particle of a later body inside an earlier body's shape (the mass
+/// there counts twice). An error or a warning naming both, by simulation.body_overlap.
+template <int D>
+void check_overlaps(const Config& config, const Particles<D>& particles, const std::vector<std::size_t>& first_of,
+                    const std::vector<ShapeBounds<D>>& bounds,
+                    const std::vector<std::shared_ptr<const GreyImage>>& images) {
+  for (std::size_t b = 1; b < config.bodies.size(); ++b)
+    for (std::size_t a = 0; a < b; ++a) {
+      const bool apart = (bounds[a].hi.array() < bounds[b].lo.array()).any() ||
+                         (bounds[b].hi.array() < bounds[a].lo.array()).any();
+      if (apart) continue;
+      std::size_t shared = 0;
+      for (std::size_t p = first_of[b]; p < first_of[b + 1]; ++p)  // (zero-volume particles carry no mass)
+        if (particles.volume0[p] > 0.0 &&
+            inside<D>(config.bodies[a].shape, images[a].get(), particles.reference_position[p]))
+          ++shared;
+      if (shared == 0) continue;
+      const BodyConfig& first = config.bodies[a];
+      const BodyConfig& second = config.bodies[b];
+      const std::string what = fmt::format(
+          "bodies '{}' ({}) and '{}' ({}) overlap: {} of the {} particles of '{}' lie inside the shape of "
+          "'{}', where the mass counts twice",
+          first.name, first.where.str(), second.name, second.where.str(), shared,
+          first_of[b + 1] - first_of[b], second.name, first.name);
+      if (config.simulation.body_overlap == "warn") {
+        std::fprintf(stderr, "cairn: warning: %s\n", what.c_str());
+        continue;
+      }
+      throw InputError(second.where.file, second.where.line, fmt::format("body[{}].shape", b),
+                       fmt::format("a shape that shares no space with another body's (or "
+                                   "simulation.body_overlap = \"warn\" to run anyway)"),
+                       what);
+    }
+}
+
 }  // namespace
 
 template <int D>
@@ -77,14 +123,17 @@ void create_particles(const Config& config, const Grid<D>& grid,
                       const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
                       Particles<D>& particles) {
   const double thickness = D == 3 ? 1.0 : config.simulation.thickness;
+  std::vector<std::size_t> first_of(config.bodies.size() + 1, 0);  // particles of body b: [first_of[b], first_of[b+1])
+  std::vector<ShapeBounds<D>> bounds_of;
+  std::vector<std::shared_ptr<const GreyImage>> image_of;
   for (std::size_t b = 0; b < config.bodies.size(); ++b) {
     const BodyConfig& body = config.bodies[b];
     int mat = -1;
     for (std::size_t m = 0; m < config.materials.size(); ++m)
       if (config.materials[m].name == body.material) mat = static_cast<int>(m);
     if (mat < 0)
-      throw std::invalid_argument(body.where.str() + ": body '" + body.name +
-                                  "': unknown material '" + body.material + "'");
+      throw InputError(body.where.file, body.where.line, fmt::format("body[{}].material", b),
+                       "the name of a [[material]]", "\"" + body.material + "\"");
     IVec<D> ppc;
     for (int a = 0; a < D; ++a) ppc[a] = body.particles_per_cell[a];
     const Vec<D> lp = grid.cell_size().cwiseQuotient(ppc.template cast<double>());
@@ -98,32 +147,38 @@ void create_particles(const Config& config, const Grid<D>& grid,
       if (!body.displacement.empty())
         displacement = std::make_unique<ExpressionVector<D>>(body.displacement, config.constants);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
+      throw InputError(body.where.file, body.where.line, fmt::format("body[{}].velocity", b),
+                       "expressions in X, Y, Z and [constants]", e.what());
     }
 
     // The picture of an image shape: read by the loader, else (a Config built in code) here,
     // once per body rather than per lattice point.
-    std::shared_ptr<const GreyImage> image = body.shape.image;
-    if (body.shape.kind == "image" && !image) {
-      try {
-        image = std::make_shared<const GreyImage>(
-            read_png_grey(resolve_input_relative(body.shape.file, config.source_file)));
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
-      }
+    std::shared_ptr<const GreyImage> image;
+    try {
+      image = body_image(body, config);
+    } catch (const std::invalid_argument& e) {  // (the loader has read the images of an input file)
+      throw std::invalid_argument(body.where.str() + ": body '" + body.name + "': " + e.what());
     }
+    const ShapeBounds<D> bounds = shape_bounds<D>(body.shape, image.get(), grid);
+    check_inside_grid<D>(body, b, bounds, grid, lp);
+    bounds_of.push_back(bounds);
+    image_of.push_back(image);
 
+    // The lattice points in the bounds, axis 0 fastest (the order of a sweep of the grid).
     const std::size_t before = particles.n();
-    const IVec<D> n_cells = grid.n_cells();
-    IVec<D> n_points = n_cells.cwiseProduct(ppc);
+    const LatticeBox<D> box = lattice_box<D>(bounds, grid, lp);
+    std::array<long long, D> span{};
     long long total = 1;
-    for (int a = 0; a < D; ++a) total *= n_points[a];
+    for (int a = 0; a < D; ++a) {
+      span[a] = std::max(0LL, box.hi[a] - box.lo[a] + 1);
+      total *= span[a];
+    }
     for (long long k = 0; k < total; ++k) {
       long long rem = k;
       Vec<D> X;
       for (int a = 0; a < D; ++a) {
-        const long long ia = rem % n_points[a];
-        rem /= n_points[a];
+        const long long ia = box.lo[a] + rem % span[a];
+        rem /= span[a];
         X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
       }
       if (!inside<D>(body.shape, image.get(), X)) continue;
@@ -150,11 +205,23 @@ void create_particles(const Config& config, const Grid<D>& grid,
         particles.deformation_gradient[p] = F;
       }
     }
-    if (particles.n() == before)
-      throw std::invalid_argument(body.where.str() + ": body '" + body.name +
-                                  "' contains no particle: its shape misses every particle "
-                                  "position of the grid");
+    if (particles.n() == before) {
+      std::string spacing;
+      for (int a = 0; a < D; ++a) spacing += fmt::format("{}{:.6g}", a ? ", " : "", lp[a]);
+      throw InputError(
+          body.where.file, body.where.line, fmt::format("body[{}].shape", b),
+          fmt::format("a shape holding at least one particle position: the lattice of "
+                      "particles_per_cell = [{}] points per grid cell (spacing [{}]) inside the grid",
+                      fmt::join(body.particles_per_cell, ", "), spacing),
+          bounds.empty() ? fmt::format("body '{}' with an empty shape (no pixel in its levels)", body.name)
+                         : fmt::format("body '{}', a {} whose bounds [{}]..[{}] hold no lattice point{}", body.name,
+                                       body.shape.kind, fmt::join(std::vector<double>(bounds.lo.begin(), bounds.lo.end()), ", "),
+                                       fmt::join(std::vector<double>(bounds.hi.begin(), bounds.hi.end()), ", "),
+                                       box.count() == 0.0 ? " inside the grid" : ""));
+    }
+    first_of[b + 1] = particles.n();
   }
+  check_overlaps<D>(config, particles, first_of, bounds_of, image_of);
   // Initial stresses of pre-deformed bodies.
   for (std::size_t p = 0; p < particles.n(); ++p) {
     if (particles.deformation_gradient[p].isIdentity(0.0)) continue;

@@ -6,11 +6,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 
+#include "cairn/fem/output.hpp"
+#include "cairn/fem/run.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -75,7 +79,21 @@ class Runner {
     std::filesystem::create_directories(dir_);
   }
 
+  /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
+  /// computed so far in history.csv.
+  ~Runner() {
+    if (std::uncaught_exceptions() == 0) return;
+    try {
+      history_writer_.flush();
+    } catch (const std::exception&) {
+      // the exception in flight says what went wrong
+    }
+  }
+  Runner(const Runner&) = delete;
+  Runner& operator=(const Runner&) = delete;
+
   void restore(const CheckpointData<D>& data) {
+    check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
     sim_.particles() = data.particles;
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
@@ -111,7 +129,7 @@ class Runner {
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
-        fail(f);
+        fail(f, dt);
       }
       last_dt_ = dt;
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
@@ -227,12 +245,13 @@ class Runner {
     write_checkpoint<D>(last_checkpoint_, data, sim_.particles());  // no copy of the particles
   }
 
-  [[noreturn]] void fail(const SimulationFailure& f) {
+  /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
+  [[noreturn]] void fail(const SimulationFailure& f, double dt) {
     history_writer_.flush();
     std::string saved;
     try {
       SnapshotWriter<D> failure(dir_, "failure");
-      failure.write(sim_.particles(), sim_.time(), sim_.step_count());
+      failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
       saved = "; the failed state could not be written";
@@ -318,6 +337,7 @@ std::string time_step_note(const Config& config) {
 }
 
 RunSummary run(const Config& config, const RunOptions& options) {
+  if (config.fem.enabled) return fem::run(config, options);
   switch (config.simulation.dimension) {
     case 1: return run_dim<1>(config, options, nullptr);
     case 2: return run_dim<2>(config, options, nullptr);
@@ -339,6 +359,7 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
 
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
                    const RunOptions& options) {
+  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, overrides, options);
   switch (checkpoint_dimension(checkpoint)) {
     case 1: return restart_dim<1>(checkpoint, overrides, options);
     case 2: return restart_dim<2>(checkpoint, overrides, options);

@@ -20,6 +20,8 @@ struct RunSummary {
   double wall_seconds = 0.0;
   double particle_steps_per_second = 0.0;
   std::size_t n_particles = 0;
+  std::string item = "particle";          ///< what n_particles counts ("element" for FEM runs)
+  std::string xdmf = "particles.xdmf";    ///< the snapshot index in output_directory
   std::filesystem::path output_directory;
   std::filesystem::path last_checkpoint;
   /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).

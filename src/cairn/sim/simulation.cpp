@@ -11,6 +11,7 @@
 #include "cairn/contact/contact.hpp"
 #include "cairn/materials/plane_stress.hpp"
 #include "cairn/math/tensor.hpp"
+#include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -58,6 +59,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   particles_.has_affine = scheme_->affine();
   particles_.has_temperature = config_.thermal.conduction;
   for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
+  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
@@ -108,6 +110,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     if (body_force_constant_) body_force_value_ = (*body_force_[0])(Vec<D>::Zero(), Vec<D>::Zero(), 0.0);
     node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
+  check_run_length<D>(*this);
 }
 
 template <int D>
@@ -119,12 +122,16 @@ void Simulation<D>::setup_grid() {
   Vec<D> origin, h;
   IVec<D> n_cells;
   std::array<bool, D> periodic{};
+  std::vector<long long> cells(D);
+  std::vector<bool> wraps(D);
   for (int a = 0; a < D; ++a) {
     origin[a] = g.origin[a];
     h[a] = g.cell_size[a];
-    n_cells[a] = static_cast<int>(std::lround(g.extent[a] / g.cell_size[a]));
-    periodic[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
+    cells[a] = std::llround(g.extent[a] / g.cell_size[a]);
+    periodic[a] = wraps[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
+  check_node_count(config_, cells, wraps, shape_->ghost_layers(), velocity_fields(config_));
+  for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
   grid_ = Grid<D>(origin, n_cells, h, shape_->ghost_layers(), periodic);
 }
 
@@ -662,7 +669,7 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   if (first_bad >= 0) {
     const auto p = static_cast<std::size_t>(first_bad);
     std::string value;
-    if (what == "det F") value = "det F = " + std::to_string(particles_.deformation_gradient[p].determinant());
+    if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
     else value = what + " is not finite";
     throw SimulationFailure(first_bad, what,
                             "particle " + std::to_string(first_bad) + " (body " +

@@ -3,10 +3,19 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace cairn {
+
+/// A number for a failure message, with 6 significant digits: "-1.23457e-07", not the
+/// "-0.000000" of std::to_string.
+inline std::string failure_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
 
 class SimulationFailure : public std::runtime_error {
  public:

@@ -1,0 +1,256 @@
+#include "cairn/fem/output.hpp"
+
+#include <fmt/format.h>
+
+#include <map>
+#include <stdexcept>
+
+#include "cairn/io/atomic_file.hpp"
+#include "cairn/io/hdf5_util.hpp"
+#include "cairn/math/tensor.hpp"
+
+namespace cairn::fem {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<double> xyz(const std::vector<Vec<2>>& v) {
+  std::vector<double> out(3 * v.size(), 0.0);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out[3 * i] = v[i][0];
+    out[3 * i + 1] = v[i][1];
+  }
+  return out;
+}
+
+std::vector<double> flat2(const std::vector<Vec<2>>& v) {
+  std::vector<double> out(2 * v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out[2 * i] = v[i][0];
+    out[2 * i + 1] = v[i][1];
+  }
+  return out;
+}
+
+std::vector<Vec<2>> unflat2(const std::vector<double>& d) {
+  std::vector<Vec<2>> out(d.size() / 2);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Vec<2>(d[2 * i], d[2 * i + 1]);
+  return out;
+}
+
+std::vector<double> flat9(const std::vector<Mat3>& m) {
+  std::vector<double> out(9 * m.size());
+  for (std::size_t e = 0; e < m.size(); ++e)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out[9 * e + 3 * i + j] = m[e](i, j);
+  return out;
+}
+
+std::vector<Mat3> unflat9(const std::vector<double>& d) {
+  std::vector<Mat3> out(d.size() / 9);
+  for (std::size_t e = 0; e < out.size(); ++e)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out[e](i, j) = d[9 * e + 3 * i + j];
+  return out;
+}
+
+}  // namespace
+
+SnapshotWriter::SnapshotWriter(fs::path directory, std::string stem)
+    : directory_(std::move(directory)), stem_(std::move(stem)) {}
+
+void SnapshotWriter::write(const Solver& s) {
+  const TriangleMesh& mesh = s.mesh();
+  const std::size_t nn = mesh.n_nodes(), ne = mesh.n_elements();
+  n_nodes_ = nn;
+  n_elements_ = ne;
+  std::vector<Vec<2>> u(nn);
+  for (std::size_t i = 0; i < nn; ++i) u[i] = s.positions()[i] - mesh.nodes[i];
+  std::vector<std::int32_t> connectivity(3 * ne);
+  std::vector<double> stress(6 * ne), mises(ne), pressure(ne), jacobian(ne), energy(ne), centroid0(3 * ne, 0.0),
+      centroid(3 * ne, 0.0);
+  for (std::size_t e = 0; e < ne; ++e) {
+    const auto& t = mesh.triangles[e];
+    for (int k = 0; k < 3; ++k) {
+      connectivity[3 * e + k] = t[k];
+      for (int a = 0; a < 2; ++a) {
+        centroid0[3 * e + a] += mesh.nodes[t[k]][a] / 3.0;
+        centroid[3 * e + a] += s.positions()[t[k]][a] / 3.0;
+      }
+    }
+    const Mat3& F = s.deformation_gradients()[e];
+    const double J = F.determinant();
+    const Mat3 sigma = cauchy_from_kirchhoff(s.kirchhoff_stresses()[e], F);
+    // the particle snapshots' order: xx, yy, zz, yz, xz, xy
+    const double voigt[6] = {sigma(0, 0), sigma(1, 1), sigma(2, 2), 0.5 * (sigma(1, 2) + sigma(2, 1)),
+                             0.5 * (sigma(0, 2) + sigma(2, 0)), 0.5 * (sigma(0, 1) + sigma(1, 0))};
+    for (int k = 0; k < 6; ++k) stress[6 * e + k] = voigt[k];
+    mises[e] = von_mises(sigma);
+    pressure[e] = -sigma.trace() / 3.0;
+    jacobian[e] = J;
+    energy[e] = s.material().energy_density(F);
+  }
+  const std::string name = fmt::format("{}-{:04d}.h5", stem_, entries_.size());
+  fs::create_directories(directory_ / "snapshots");
+  write_file_atomically(directory_ / "snapshots" / name, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp);
+    const hid_t root = file.get();
+    h5::write_string_attribute(root, "format", "cairn-fem-snapshot");
+    h5::write_double_attribute(root, "time", s.time());
+    h5::write_int64_attribute(root, "step", s.step_count());
+    {
+      h5::Handle g = h5::create_group(root, "nodes");
+      h5::write_doubles(g.get(), "reference_position", xyz(mesh.nodes).data(), nn, 3);
+      h5::write_doubles(g.get(), "position", xyz(s.positions()).data(), nn, 3);
+      h5::write_doubles(g.get(), "displacement", xyz(u).data(), nn, 3);
+      h5::write_doubles(g.get(), "velocity", xyz(s.velocities()).data(), nn, 3);
+      h5::write_doubles(g.get(), "acceleration", xyz(s.accelerations()).data(), nn, 3);
+      h5::write_doubles(g.get(), "mass", s.masses().data(), nn);
+    }
+    {
+      h5::Handle g = h5::create_group(root, "elements");
+      h5::write_ints(g.get(), "connectivity", connectivity.data(), 3 * ne);
+      h5::write_doubles(g.get(), "reference_centroid", centroid0.data(), ne, 3);
+      h5::write_doubles(g.get(), "centroid", centroid.data(), ne, 3);
+      h5::write_doubles(g.get(), "stress", stress.data(), ne, 6);
+      h5::write_doubles(g.get(), "von_mises", mises.data(), ne);
+      h5::write_doubles(g.get(), "pressure", pressure.data(), ne);
+      h5::write_doubles(g.get(), "jacobian", jacobian.data(), ne);
+      h5::write_doubles(g.get(), "strain_energy_density", energy.data(), ne);
+      h5::write_doubles(g.get(), "reference_volume", s.reference_volumes().data(), ne);
+    }
+  });
+  entries_.emplace_back(s.time(), name);
+  write_xdmf();
+}
+
+void SnapshotWriter::write_xdmf() const {
+  std::string x =
+      "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+      "<Xdmf Version=\"3.0\">\n  <Domain>\n"
+      "    <Grid Name=\"fem\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  const std::string nn = std::to_string(n_nodes_), ne = std::to_string(n_elements_);
+  for (const auto& [time, file] : entries_) {
+    if (!fs::exists(directory_ / "snapshots" / file)) continue;
+    const auto item = [&](const std::string& dims, bool integer, const std::string& set) {
+      return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">snapshots/{}:{}</DataItem>",
+                         dims, integer ? "Int" : "Float", integer ? 4 : 8, file, set);
+    };
+    const auto attr = [&](const std::string& name, const char* type, const char* center, const std::string& dims,
+                          const std::string& set) {
+      return fmt::format("        <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">{}</Attribute>\n", name,
+                         type, center, item(dims, false, set));
+    };
+    x += fmt::format("      <Grid Name=\"{}\" GridType=\"Uniform\">\n        <Time Value=\"{:.17g}\"/>\n", file, time);
+    x += fmt::format("        <Topology TopologyType=\"Triangle\" NumberOfElements=\"{}\">{}</Topology>\n", ne,
+                     item(ne + " 3", true, "/elements/connectivity"));
+    x += fmt::format("        <Geometry GeometryType=\"XYZ\">{}</Geometry>\n", item(nn + " 3", false, "/nodes/position"));
+    x += attr("displacement", "Vector", "Node", nn + " 3", "/nodes/displacement");
+    x += attr("velocity", "Vector", "Node", nn + " 3", "/nodes/velocity");
+    x += attr("mass", "Scalar", "Node", nn, "/nodes/mass");
+    x += attr("stress", "Matrix", "Cell", ne + " 6", "/elements/stress");
+    x += attr("von_mises", "Scalar", "Cell", ne, "/elements/von_mises");
+    x += attr("pressure", "Scalar", "Cell", ne, "/elements/pressure");
+    x += attr("jacobian", "Scalar", "Cell", ne, "/elements/jacobian");
+    x += attr("strain_energy_density", "Scalar", "Cell", ne, "/elements/strain_energy_density");
+    x += "      </Grid>\n";
+  }
+  x += "    </Grid>\n  </Domain>\n</Xdmf>\n";
+  write_text_atomically(xdmf_path(), x);
+}
+
+void write_checkpoint(const fs::path& path, const Checkpoint& d) {
+  write_file_atomically(path, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp);
+    const hid_t root = file.get();
+    h5::write_string_attribute(root, "format", checkpoint_format);
+    h5::write_int64_attribute(root, "version", 1);
+    h5::write_text(root, "input", d.config_toml);
+    const auto& s = d.state;
+    std::map<std::string, double> scalars = d.scalars;
+    scalars["time"] = s.time;
+    scalars["external_work"] = s.external_work;
+    scalars["step"] = static_cast<double>(s.step);
+    scalars["displacement_error"] = s.error_now;
+    scalars["displacement_error_max"] = s.error_max;
+    std::vector<std::string> names;
+    std::vector<double> values;
+    for (const auto& [k, v] : scalars) {
+      names.push_back(k);
+      values.push_back(v);
+    }
+    h5::write_text_list(root, "scalar_names", names);
+    h5::write_doubles(root, "scalar_values", values.data(), values.size());
+    h5::write_doubles(root, "x", flat2(s.x).data(), s.x.size(), 2);
+    h5::write_doubles(root, "v", flat2(s.v).data(), s.v.size(), 2);
+    h5::write_doubles(root, "a", flat2(s.a).data(), s.a.size(), 2);
+    h5::write_doubles(root, "b", flat2(s.b).data(), s.b.size(), 2);
+    h5::write_doubles(root, "reaction", flat2(s.reaction).data(), s.reaction.size(), 2);
+    h5::write_doubles(root, "F", flat9(s.F).data(), s.F.size(), 9);
+    h5::write_doubles(root, "tau", flat9(s.tau).data(), s.tau.size(), 9);
+    h5::write_doubles(root, "element_state", s.element_state.data(), s.element_state.size());
+    h5::write_doubles(root, "temperature", s.temperature.data(), s.temperature.size());
+    h5::write_text_list(root, "history_columns", d.history_columns);
+    std::vector<double> rows;
+    for (const auto& r : d.history_rows) rows.insert(rows.end(), r.begin(), r.end());
+    h5::write_doubles_shaped(root, "history_rows", rows.data(), {d.history_rows.size(), d.history_columns.size()});
+    std::vector<double> times;
+    std::vector<std::string> files;
+    for (const auto& [t, f] : d.snapshots) {
+      times.push_back(t);
+      files.push_back(f);
+    }
+    h5::write_doubles(root, "snapshot_times", times.data(), times.size());
+    h5::write_text_list(root, "snapshot_files", files);
+  });
+}
+
+bool is_checkpoint(const fs::path& path) {
+  try {
+    h5::silence_errors();
+    h5::Handle file = h5::open_file(path);
+    return h5::has_attribute(file.get(), "format") &&
+           h5::read_string_attribute(file.get(), "format") == checkpoint_format;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+Checkpoint read_checkpoint(const fs::path& path) {
+  if (!is_checkpoint(path)) throw std::runtime_error("'" + path.string() + "' is not a Cairn FEM checkpoint");
+  h5::Handle file = h5::open_file(path);
+  const hid_t root = file.get();
+  Checkpoint d;
+  d.config_toml = h5::read_text(root, "input");
+  const auto names = h5::read_text_list(root, "scalar_names");
+  const auto values = h5::read_doubles(root, "scalar_values", {names.size()});
+  for (std::size_t k = 0; k < names.size(); ++k) d.scalars[names[k]] = values[k];
+  auto& s = d.state;
+  s.time = d.scalars.at("time");
+  s.external_work = d.scalars.at("external_work");
+  s.step = static_cast<long long>(d.scalars.at("step"));
+  s.error_now = d.scalars.at("displacement_error");
+  s.error_max = d.scalars.at("displacement_error_max");
+  const auto read = [&](const std::string& name) { return h5::read_doubles(root, name, h5::dataset_shape(root, name)); };
+  s.x = unflat2(read("x"));
+  s.v = unflat2(read("v"));
+  s.a = unflat2(read("a"));
+  s.b = unflat2(read("b"));
+  s.reaction = unflat2(read("reaction"));
+  s.F = unflat9(read("F"));
+  s.tau = unflat9(read("tau"));
+  s.element_state = read("element_state");
+  s.temperature = read("temperature");
+  d.history_columns = h5::read_text_list(root, "history_columns");
+  const auto rows = read("history_rows");
+  const std::size_t nc = d.history_columns.size();
+  for (std::size_t r = 0; nc > 0 && r < rows.size() / nc; ++r)
+    d.history_rows.emplace_back(rows.begin() + static_cast<std::ptrdiff_t>(r * nc),
+                                rows.begin() + static_cast<std::ptrdiff_t>((r + 1) * nc));
+  const auto times = read("snapshot_times");
+  const auto files = h5::read_text_list(root, "snapshot_files");
+  for (std::size_t k = 0; k < times.size() && k < files.size(); ++k) d.snapshots.emplace_back(times[k], files[k]);
+  return d;
+}
+
+}  // namespace cairn::fem
