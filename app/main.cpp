@@ -1,8 +1,10 @@
 // The `cairn` command: run, check, keys, restart.
 //
-// Exit codes: 0 success; 2 bad input (file, line, key, expected vs. found) or a bad command
-// line; 3 the simulation failed (which particle, step, time and quantity), after writing its
-// last good output; 1 anything else (an I/O failure such as a full disk, an internal error).
+// Exit codes: 0 success (also --help, --version); 2 bad input (file, line, key, expected vs.
+// found) or a bad command line (no or unknown subcommand, unknown option: a usage line follows);
+// 3 the simulation failed (which particle, step, time and quantity), after writing its last good
+// output; 1 anything else (an I/O failure such as a full disk, an internal error, or SIGINT/SIGTERM, after writing
+// checkpoint-autosave.h5).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
@@ -74,6 +76,13 @@ void print_summary(const cairn::RunSummary& s) {
   }
 }
 
+constexpr const char* usage =
+    "usage: cairn run INPUT.toml [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn check INPUT.toml [--set section.key=value]...\n"
+    "       cairn restart CHECKPOINT.h5 [--set section.key=value]... [-q] [-t THREADS]\n"
+    "       cairn keys [--markdown]\n"
+    "       cairn --help | --version\n";
+
 void print_warnings(const cairn::Config& config) {
   for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
 }
@@ -87,6 +96,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
   app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
   app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success; 2 bad input or command line; 3 the simulation failed (last good\n"
+      "output kept); 1 any other error, or interrupted by SIGINT/SIGTERM (after writing\n"
+      "checkpoint-autosave.h5). A first simulation: docs/tutorial.md; the files: docs/output.md.");
 
   std::string input;
   std::vector<std::string> overrides;
@@ -118,8 +131,15 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help, the version or the error
-    return code == 0 ? 0 : 2;      // a bad command line is bad input
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::string what = e.what();
+    if (argc < 2) {
+      what = "no command given";
+    } else if (app.get_subcommands().empty()) {
+      what = fmt::format("unknown command or option '{}'", argv[1]);
+    }
+    std::cerr << "cairn: " << what << "\n" << usage;
+    return 2;
   }
   if (threads > 0) omp_set_num_threads(threads);
 
@@ -159,6 +179,9 @@ int main(int argc, char** argv) {
   } catch (const cairn::RunFailure& e) {
     std::cerr << "cairn: " << e.what() << "\n";
     return 3;
+  } catch (const cairn::RunInterrupted& e) {
+    std::cerr << "cairn: " << e.what() << "\n";
+    return 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";
     return 1;

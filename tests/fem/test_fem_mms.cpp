@@ -56,10 +56,10 @@ double mms_error(double size, const std::string& mesher) {
   return err;
 }
 
-/// Order 2 asserted as > 1.8. Structured meshes are nested refinements of one pattern: every
-/// pair of successive meshes must show it. Gmsh's meshes of a sequence are not nested (the element
-/// shapes differ from mesh to mesh), so their order is the least-squares slope of log error
-/// against log h over the sequence; the pairwise orders are printed for both.
+/// Order 2 asserted as > 1.8 for every pair of successive meshes, whatever the mesher. Gmsh's
+/// meshes of a sequence are not nested (element shapes differ from mesh to mesh), so the
+/// least-squares slope of log error against log h over the sequence is printed beside the pairwise
+/// orders as a second reading; it is not a substitute for the pairwise assertion.
 void check_orders(const std::string& label, const std::string& mesher, const std::vector<double>& sizes,
                   const std::vector<double>& errors) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -71,11 +71,10 @@ void check_orders(const std::string& label, const std::string& mesher, const std
     const double order = std::log(errors[k] / errors[k + 1]) / std::log(sizes[k] / sizes[k + 1]);
     std::printf("%s %s h = %.5g -> %.5g: L_inf %.4e -> %.4e, order %.3f\n", label.c_str(), mesher.c_str(), sizes[k],
                 sizes[k + 1], errors[k], errors[k + 1], order);
-    if (mesher == "structured") EXPECT_GT(order, 1.8) << label << " " << mesher << " h = " << sizes[k + 1];
+    EXPECT_GT(order, 1.8) << label << " " << mesher << " h = " << sizes[k + 1];
   }
   const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
   std::printf("%s %s least-squares order %.3f\n", label.c_str(), mesher.c_str(), slope);
-  if (mesher != "structured") EXPECT_GT(slope, 1.8) << label << " " << mesher;
 }
 
 void expect_second_order(const std::string& mesher, const std::vector<double>& sizes) {
@@ -102,12 +101,18 @@ void expect_ring_second_order(const std::string& mesher, const std::vector<doubl
 
 TEST(FemMms, RingSecondOrderInDisplacement) { expect_ring_second_order("structured", {0.1, 0.05, 0.025}); }
 
-// The fuller sweep, under the `long` label (tests/CMakeLists.txt): finer structured meshes and
-// unstructured Gmsh meshes.
+// The fuller sweep, under the `long` label (tests/CMakeLists.txt): finer structured meshes.
 TEST(FemLong, DISABLED_SecondOrderInDisplacementSweep) {
   expect_second_order("structured", {1.0 / 16, 1.0 / 32, 1.0 / 64, 1.0 / 128});
-  expect_second_order("gmsh", {1.0 / 8, 1.0 / 16, 1.0 / 32, 1.0 / 64});
   expect_ring_second_order("structured", {0.1, 0.05, 0.025, 0.0125, 0.00625});
+}
+
+// Unstructured Gmsh sequences, label `known-failure` (tests/CMakeLists.txt): the square passes
+// pair by pair (1.98, 2.01, 2.02), but the ring's coarsest pair measured 1.78 < 1.8 (then 2.12,
+// 1.98; least-squares slope 1.97) because the non-nested meshes change element shapes between
+// sizes. Recorded in docs/fem.md; the assertion stays as for the structured sequences.
+TEST(FemKnownFailure, DISABLED_GmshSecondOrderInDisplacementSweep) {
+  expect_second_order("gmsh", {1.0 / 8, 1.0 / 16, 1.0 / 32, 1.0 / 64});
   expect_ring_second_order("gmsh", {0.1, 0.05, 0.025, 0.0125});
 }
 

@@ -259,7 +259,7 @@ TEST(InputErrors, UnknownMaterialModel) {
 TEST(InputErrors, BodyShapeOfUnknownKind) {
   EXPECT_EQ(message(error_of(with("{ box = { min", "{ cube = { min"))),
             "case.toml:26: key 'body[0].shape.cube': expected a shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere, image; found \"cube\"");
+            "ellipse, annulus, polygon, sphere, cylinder, image; found \"cube\"");
   EXPECT_EQ(message(error_of(with("shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] } }",
                                   "shape = { sphere = { center = [0.03, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape.sphere': expected a shape kind valid in 2D, one of box, "
@@ -268,7 +268,7 @@ TEST(InputErrors, BodyShapeOfUnknownKind) {
                                   "shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] }, "
                                   "circle = { center = [0.1, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape': expected exactly one shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere, image; found 2 kinds: box, circle");
+            "ellipse, annulus, polygon, sphere, cylinder, image; found 2 kinds: box, circle");
 }
 
 TEST(InputErrors, BodyShapeMissingItsParameters) {
@@ -627,7 +627,11 @@ TEST(Input, LoadsFromAFile) {
   const Config c = load_config(path, {"method.order=2"});
   EXPECT_EQ(c.source_file, path);
   EXPECT_EQ(c.method.order, 2);
-  EXPECT_EQ(c.output.directory, "out/two_blocks");
+  // A relative output folder lies next to the input file; one given with --set is taken as typed.
+  EXPECT_EQ(c.output.directory, (dir / "out/two_blocks").string());
+  EXPECT_EQ(load_config(path, {"output.directory=\"x/y\""}).output.directory, "x/y");
+  EXPECT_EQ(load_config(path, {" output.directory = rel"}).output.directory, "rel");
+  EXPECT_NE(c.resolved_toml.find("directory = \"" + (dir / "out/two_blocks").string() + "\""), std::string::npos);
   try {
     load_config(path, {"method.shape=\"cpdii\""});
     FAIL() << "expected an InputError";

@@ -30,5 +30,18 @@ TEST(InputDocs, InputMdMatchesTheDeclarations) {
          "(or run this test with CAIRN_UPDATE_DOCS=1) and commit the result.";
 }
 
+TEST(InputDocs, KeysFitA100ColumnTerminal) {
+  std::istringstream text(keys_text(false));
+  std::string line;
+  int n = 0;
+  while (std::getline(text, line)) {
+    ++n;
+    EXPECT_LE(line.size(), 100u) << "line " << n << " of `cairn keys`: " << line;
+  }
+  EXPECT_GT(n, 100);
+  // Every documented key is still there (its name starts a row).
+  EXPECT_NE(keys_text(false).find("\n  checkpoint_wall_interval  "), std::string::npos);
+}
+
 }  // namespace
 }  // namespace cairn

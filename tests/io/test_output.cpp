@@ -1,4 +1,5 @@
 // Tests of the output layer: atomic writes, history CSV, HDF5/XDMF snapshots, checkpoints.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <unistd.h>
@@ -21,6 +22,8 @@
 #include "cairn/io/hdf5_util.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/io/units.hpp"
+#include "cairn/util/sha256.hpp"
 
 namespace fs = std::filesystem;
 using namespace cairn;
@@ -356,9 +359,9 @@ TEST(Checkpoint, NonCheckpointFilesThrowClearly) {
   {
     h5::Handle f(H5Fopen(future.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
     ASSERT_GE(f.get(), 0);
-    h5::write_int64_attribute(f.get(), "version", 2);
+    h5::write_int64_attribute(f.get(), "version", checkpoint_format_version + 1);
   }
-  expect_message(future, "version 2");
+  expect_message(future, fmt::format("version {}", checkpoint_format_version + 1));
 }
 
 TEST(Checkpoint, InconsistentParticlesRejected) {
@@ -415,7 +418,7 @@ TEST(Snapshot, WritesParticlesAndXdmf) {
   EXPECT_EQ(h5::read_doubles(g.get(), "volume", {2}), (std::vector<double>{1.0, 0.25}));
   const auto stress = h5::read_doubles(g.get(), "stress", {2, 6});
   EXPECT_EQ(std::vector<double>(stress.begin(), stress.begin() + 6),
-            (std::vector<double>{2.0, 1.0, 1.0, 0.0, 0.0, 3.0}));
+            (std::vector<double>{2.0, 1.0, 1.0, 3.0, 0.0, 0.0}));  // xx yy zz xy yz xz
   EXPECT_DOUBLE_EQ(h5::read_doubles(g.get(), "pressure", {2})[0], -4.0 / 3.0);
   EXPECT_DOUBLE_EQ(h5::read_doubles(g.get(), "von_mises", {2})[0], std::sqrt(1.0 + 27.0));
   const auto F = h5::read_doubles(g.get(), "deformation_gradient", {2, 9});
@@ -443,24 +446,28 @@ TEST(Snapshot, GridDataAndGridXdmf) {
   writer.write(ps, 0.0, 0, &grid, &nodes);
   ASSERT_TRUE(fs::exists(writer.grid_xdmf_path()));
   EXPECT_EQ(writer.grid_xdmf_path(), dir.path() / "grid.xdmf");
+  // The domain nodes only (5 x 3: no ghost layer in x, the periodic y axis repeats its first
+  // node row), as a 3D mesh one node thick in z, in the x-y plane (origin and spacing z y x).
   const std::string xdmf = read_all(writer.grid_xdmf_path());
-  EXPECT_NE(xdmf.find("TopologyType=\"2DCoRectMesh\" Dimensions=\"2 7\""), std::string::npos) << xdmf;
-  EXPECT_NE(xdmf.find(">2 0.5</DataItem>"), std::string::npos) << xdmf;     // origin y x
-  EXPECT_NE(xdmf.find(">0.25 0.5</DataItem>"), std::string::npos) << xdmf;  // spacing y x
-  EXPECT_NE(xdmf.find("snapshots/particles-000000.h5:/grid/node_velocity"), std::string::npos);
+  EXPECT_NE(xdmf.find("TopologyType=\"3DCoRectMesh\" Dimensions=\"1 3 5\""), std::string::npos) << xdmf;
+  EXPECT_NE(xdmf.find(">0 2 1</DataItem>"), std::string::npos) << xdmf;       // origin z y x
+  EXPECT_NE(xdmf.find(">1 0.25 0.5</DataItem>"), std::string::npos) << xdmf;  // spacing z y x
+  EXPECT_NE(xdmf.find("Dimensions=\"1 3 5 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
+                      "snapshots/particles-000000.h5:/grid/node_velocity"),
+            std::string::npos) << xdmf;
 
   h5::Handle f = h5::open_file(writer.snapshot_path(0));
   h5::Handle g = h5::open_group(f.get(), "grid");
-  EXPECT_EQ(h5::dataset_shape(g.get(), "node_mass"), (std::vector<std::size_t>{2, 7}));
-  const auto mass = h5::read_doubles(g.get(), "node_mass", {2, 7});
-  EXPECT_EQ(mass, nodes.mass);
-  const auto vel = h5::read_doubles(g.get(), "node_velocity", {2, 7, 3});
-  EXPECT_EQ(vel[3 * 9 + 0], 9.0);
-  EXPECT_EQ(vel[3 * 9 + 1], -9.0);
-  EXPECT_EQ(vel[3 * 9 + 2], 0.0);
-  EXPECT_EQ(h5::read_doubles_attribute(g.get(), "origin"), (std::vector<double>{0.5, 2.0, 0.0}));
-  // Stored node 0 really is at the origin written.
-  EXPECT_EQ(grid.node_position(0), Vec<2>(0.5, 2.0));
+  EXPECT_EQ(h5::dataset_shape(g.get(), "node_mass"), (std::vector<std::size_t>{3, 5}));
+  const auto mass = h5::read_doubles(g.get(), "node_mass", {3, 5});
+  // Stored node index = (jx + 1) + 7 (jy mod 2): one ghost layer in x, y periodic.
+  EXPECT_EQ(mass, (std::vector<double>{1, 2, 3, 4, 5, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5}));
+  const auto vel = h5::read_doubles(g.get(), "node_velocity", {3, 5, 3});
+  EXPECT_EQ(vel[3 * 7 + 0], 10.0);  // node (jx, jy) = (2, 1)
+  EXPECT_EQ(vel[3 * 7 + 1], -10.0);
+  EXPECT_EQ(vel[3 * 7 + 2], 0.0);
+  EXPECT_EQ(h5::read_doubles_attribute(g.get(), "origin"), (std::vector<double>{1.0, 2.0, 0.0}));
+  EXPECT_EQ(h5::read_doubles_attribute(g.get(), "spacing"), (std::vector<double>{0.5, 0.25, 1.0}));
 }
 
 TEST(Snapshot, OtherDimensionsWrite) {
@@ -473,7 +480,7 @@ TEST(Snapshot, OtherDimensionsWrite) {
     ps.add(Vec<1>(0.5), Vec<1>(1.0), 1.0, 1.0, Vec<1>(0.5), 0, 0);
     SnapshotWriter<1> writer(dir.path() / "d1");
     writer.write(ps, 0.0, 0, &grid, &nodes);
-    EXPECT_NE(read_all(writer.grid_xdmf_path()).find("Dimensions=\"1 8\""), std::string::npos);
+    EXPECT_NE(read_all(writer.grid_xdmf_path()).find("Dimensions=\"1 1 4\""), std::string::npos);
     h5::Handle f = h5::open_file(writer.snapshot_path(0));
     h5::Handle g = h5::open_group(f.get(), "particles");
     EXPECT_EQ(h5::read_doubles(g.get(), "velocity", {1, 3}), (std::vector<double>{1.0, 0.0, 0.0}));
@@ -489,8 +496,9 @@ TEST(Snapshot, OtherDimensionsWrite) {
     EXPECT_TRUE(fs::exists(dir.path() / "d3" / "solid.xdmf"));
     EXPECT_TRUE(fs::exists(dir.path() / "d3" / "snapshots" / "solid-000000.h5"));
     const std::string xdmf = read_all(writer.grid_xdmf_path());
-    EXPECT_NE(xdmf.find("TopologyType=\"3DCoRectMesh\" Dimensions=\"7 6 5\""), std::string::npos) << xdmf;
-    EXPECT_NE(xdmf.find(">-3 -2 -1</DataItem>"), std::string::npos) << xdmf;
+    EXPECT_NE(xdmf.find("TopologyType=\"3DCoRectMesh\" Dimensions=\"5 4 3\""), std::string::npos) << xdmf;
+    EXPECT_NE(xdmf.find(">0 0 0</DataItem>"), std::string::npos) << xdmf;  // no ghost layers
+    EXPECT_NE(xdmf.find(">3 2 1</DataItem>"), std::string::npos) << xdmf;
   }
 }
 
@@ -538,4 +546,205 @@ TEST(Snapshot, MissingListedFileIsLeftOut) {
   EXPECT_EQ(xdmf.find("particles-000000.h5"), std::string::npos);
   EXPECT_NE(xdmf.find("particles-000001.h5"), std::string::npos);
   EXPECT_EQ(writer.entries().size(), 2u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Self-describing files (issue 15)
+
+TEST(Sha256, KnownDigests) {
+  // FIPS 180-4 examples (NIST CSRC) and the empty string.
+  EXPECT_EQ(sha256_hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(sha256_hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(Units, SymbolsFollowTheDeclaredSystem) {
+  EXPECT_EQ(unit_symbol("SI", Quantity::stress), "Pa");
+  EXPECT_EQ(unit_symbol("mm_t_s", Quantity::stress), "MPa");
+  EXPECT_EQ(unit_symbol("mm_t_s", Quantity::energy), "mJ");
+  EXPECT_EQ(unit_symbol("mm_kg_ms", Quantity::stress), "GPa");
+  EXPECT_EQ(unit_symbol("mm_kg_ms", Quantity::velocity), "m/s");
+  EXPECT_EQ(unit_symbol("unspecified", Quantity::force), "mass*length/time^2");
+  EXPECT_THROW((void)unit_symbol("furlong", Quantity::length), std::invalid_argument);
+  for (const auto& name : unit_system_names()) EXPECT_EQ(unit_symbol(name, Quantity::dimensionless), "1");
+}
+
+namespace {
+
+OutputMetadata example_metadata() {
+  OutputMetadata m;
+  m.title = "probe";
+  m.units = "mm_t_s";
+  m.material_names = {"steel", "rubber"};
+  m.body_names = {"left", "right", "ball"};
+  m.input_toml = "[simulation]\ndimension = 2\n";
+  return m;
+}
+
+std::string dataset_attribute(hid_t loc, const std::string& dataset, const std::string& name) {
+  h5::Handle d(H5Dopen2(loc, dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  EXPECT_GE(d.get(), 0) << dataset;
+  return h5::read_string_attribute(d.get(), name);
+}
+
+}  // namespace
+
+TEST(Snapshot, FilesDescribeThemselves) {
+  TempDir dir;
+  Particles<2> ps;
+  ps.add(Vec<2>(0.1, 0.2), Vec<2>(1.0, -2.0), 3.0, 0.5, Vec<2>(0.1, 0.1), 1, 2);
+  ps.add(Vec<2>(0.3, 0.4), Vec<2>(0.0, 0.0), 5.0, 0.25, Vec<2>(0.1, 0.1), 0, 1);
+  ps.deformation_gradient[1] << 1.0, 0.5, 0.0, 0.25, 2.0, 0.0, 0.0, 0.0, 1.0;
+  const OutputMetadata meta = example_metadata();
+  SnapshotWriter<2> writer(dir.path(), "particles", meta);
+  writer.write(ps, 0.25, 7);
+
+  h5::Handle f = h5::open_file(writer.snapshot_path(0));
+  const hid_t root = f.get();
+  EXPECT_EQ(h5::read_string_attribute(root, "format"), "cairn-snapshot");
+  EXPECT_EQ(h5::read_int64_attribute(root, "format_version"), snapshot_format_version);
+  EXPECT_EQ(h5::read_string_attribute(root, "cairn_version"), CAIRN_VERSION);
+  EXPECT_EQ(h5::read_string_attribute(root, "title"), "probe");
+  EXPECT_EQ(h5::read_string_attribute(root, "units"), "mm_t_s");
+  EXPECT_EQ(h5::read_string_attribute(root, "unit_length"), "mm");
+  EXPECT_EQ(h5::read_string_attribute(root, "unit_mass"), "t");
+  EXPECT_EQ(h5::read_string_attribute(root, "time_units"), "s");
+  EXPECT_EQ(h5::read_string_attribute(root, "input_sha256"), sha256_hex(meta.input_toml));
+  EXPECT_EQ(h5::read_text(root, "input"), meta.input_toml);
+  EXPECT_EQ(h5::read_text_list(root, "material_names"), meta.material_names);
+  EXPECT_EQ(h5::read_text_list(root, "body_names"), meta.body_names);
+
+  h5::Handle g = h5::open_group(root, "particles");
+  EXPECT_EQ(dataset_attribute(g.get(), "stress", "units"), "MPa");
+  EXPECT_EQ(dataset_attribute(g.get(), "stress", "components"), "xx yy zz xy yz xz");
+  EXPECT_EQ(dataset_attribute(g.get(), "velocity", "units"), "mm/s");
+  EXPECT_EQ(dataset_attribute(g.get(), "position", "components"), "x y z");
+  EXPECT_EQ(dataset_attribute(g.get(), "deformation_gradient", "components"), "xx xy xz yx yy yz zx zy zz");
+  EXPECT_EQ(dataset_attribute(g.get(), "mass", "units"), "t");
+  EXPECT_FALSE(dataset_attribute(g.get(), "von_mises", "description").empty());
+  EXPECT_EQ(h5::read_ints(g.get(), "connectivity", 2), (std::vector<std::int32_t>{0, 1}));
+  // The row views of F read like ordinary arrays.
+  EXPECT_EQ(h5::read_doubles(g.get(), "deformation_gradient_x", {2, 3}),
+            (std::vector<double>{1, 0, 0, 1.0, 0.5, 0.0}));
+  EXPECT_EQ(h5::read_doubles(g.get(), "deformation_gradient_y", {2, 3}),
+            (std::vector<double>{0, 1, 0, 0.25, 2.0, 0.0}));
+  EXPECT_EQ(dataset_attribute(g.get(), "deformation_gradient_y", "components"), "yx yy yz");
+
+  // The XDMF gives every reader its cells, the stress as a symmetric tensor and the rows of F.
+  const std::string xdmf = read_all(writer.particles_xdmf_path());
+  EXPECT_NE(xdmf.find("NodesPerElement=\"1\">\n          <DataItem Dimensions=\"2\" NumberType=\"Int\" "
+                      "Precision=\"4\" Format=\"HDF\">snapshots/particles-000000.h5:/particles/connectivity"),
+            std::string::npos) << xdmf;
+  EXPECT_NE(xdmf.find("<Attribute Name=\"stress\" AttributeType=\"Tensor6\""), std::string::npos);
+  EXPECT_NE(xdmf.find("<Attribute Name=\"deformation_gradient_z\" AttributeType=\"Vector\""), std::string::npos);
+}
+
+TEST(Snapshot, CompressionKeyChunksLargeDatasets) {
+  TempDir dir;
+  Particles<3> ps;
+  const std::size_t n = 5000;
+  for (std::size_t p = 0; p < n; ++p)
+    ps.add(Vec<3>(0.001 * p, 0.5, 0.5), Vec<3>(1.0, 0.0, 0.0), 1.0, 1.0, Vec<3>(0.1, 0.1, 0.1), 0, 0);
+  auto filters = [](const fs::path& file, const std::string& dataset) {
+    h5::Handle f = h5::open_file(file);
+    h5::Handle d(H5Dopen2(f.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+    h5::Handle plist(H5Dget_create_plist(d.get()), H5Pclose);
+    return std::make_pair(H5Pget_layout(plist.get()), H5Pget_nfilters(plist.get()));
+  };
+  OutputMetadata meta;
+  SnapshotWriter<3> plain(dir.path() / "plain", "particles", meta);
+  plain.write(ps, 0.0, 0);
+  EXPECT_EQ(filters(plain.snapshot_path(0), "/particles/position"), std::make_pair(H5D_CONTIGUOUS, 0));
+  meta.compression = 6;
+  SnapshotWriter<3> packed(dir.path() / "packed", "particles", meta);
+  packed.write(ps, 0.0, 0);
+  EXPECT_EQ(filters(packed.snapshot_path(0), "/particles/position"), std::make_pair(H5D_CHUNKED, 2));  // shuffle, gzip
+  EXPECT_EQ(filters(packed.snapshot_path(0), "/particles/material"), std::make_pair(H5D_CHUNKED, 2));
+  EXPECT_LT(fs::file_size(packed.snapshot_path(0)), fs::file_size(plain.snapshot_path(0)) / 4);
+  h5::Handle f = h5::open_file(packed.snapshot_path(0));
+  h5::Handle g = h5::open_group(f.get(), "particles");
+  const auto x = h5::read_doubles(g.get(), "position", {n, 3});
+  EXPECT_EQ(x[3 * 4321], 0.001 * 4321);
+  EXPECT_EQ(x[3 * 4321 + 1], 0.5);
+}
+
+TEST(Snapshot, RestoreCutsTheSeriesBackAtOnce) {
+  TempDir dir;
+  Particles<2> ps;
+  ps.add(Vec<2>(0.5, 0.5), Vec<2>(0, 0), 1.0, 1.0, Vec<2>(0.5, 0.5), 0, 0);
+  Grid<2> grid(Vec<2>(0.0, 0.0), IVec<2>(2, 2), Vec<2>(1.0, 1.0), 1, {false, false});
+  NodeField<2> nodes;
+  nodes.resize(grid.n_nodes());
+  std::vector<std::pair<double, std::string>> saved;
+  {
+    SnapshotWriter<2> first(dir.path());
+    first.write(ps, 0.0, 0);
+    first.write(ps, 0.1, 1);
+    saved = first.entries();
+    first.write(ps, 0.2, 2, &grid, &nodes);  // after the "checkpoint": grid data
+    first.write(ps, 0.3, 3, &grid, &nodes);
+  }
+  std::ofstream(dir.path() / "snapshots" / "other-000005.h5") << "not ours";
+  ASSERT_TRUE(fs::exists(dir.path() / "grid.xdmf"));
+  SnapshotWriter<2> second(dir.path());
+  second.restore(saved, 2);
+  EXPECT_EQ(list_dir(dir.path() / "snapshots"),
+            (std::vector<std::string>{"other-000005.h5", "particles-000000.h5", "particles-000001.h5"}));
+  const std::string xdmf = read_all(second.particles_xdmf_path());
+  EXPECT_NE(xdmf.find("particles-000001.h5"), std::string::npos);
+  EXPECT_EQ(xdmf.find("particles-000002.h5"), std::string::npos);
+  EXPECT_EQ(xdmf.find("<Time Value=\"0.2\"/>"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir.path() / "grid.xdmf"));  // no listed snapshot has grid data now
+  EXPECT_EQ(second.next_index(), 2);
+}
+
+TYPED_TEST(CheckpointTest, VectorsAreStoredWithThreeComponents) {
+  constexpr int D = TypeParam::value;
+  TempDir dir;
+  std::mt19937_64 rng(17);
+  CheckpointData<D> data;
+  data.particles = random_particles<D>(5, 2, rng);
+  data.metadata = example_metadata();
+  data.config_toml = "[simulation]\ndimension = " + std::to_string(D) + "\n";
+  const fs::path file = dir.path() / "c.h5";
+  write_checkpoint<D>(file, data);
+  {
+    h5::Handle f = h5::open_file(file);
+    EXPECT_EQ(h5::read_int64_attribute(f.get(), "version"), checkpoint_format_version);
+    EXPECT_EQ(h5::read_string_attribute(f.get(), "units"), "mm_t_s");
+    EXPECT_EQ(h5::read_string_attribute(f.get(), "cairn_version"), CAIRN_VERSION);
+    EXPECT_EQ(h5::read_string_attribute(f.get(), "input_sha256"), sha256_hex(data.config_toml));
+    EXPECT_EQ(h5::read_text_list(f.get(), "body_names"), data.metadata.body_names);
+    h5::Handle g = h5::open_group(f.get(), "particles");
+    for (const char* name : {"position", "reference_position", "velocity", "size0"}) {
+      EXPECT_EQ(h5::dataset_shape(g.get(), name), (std::vector<std::size_t>{5, 3})) << name;
+      const auto v = h5::read_doubles(g.get(), name, {5, 3});
+      for (std::size_t p = 0; p < 5; ++p)
+        for (int a = D; a < 3; ++a) EXPECT_EQ(v[3 * p + a], 0.0) << name;
+    }
+  }
+  const CheckpointData<D> back = read_checkpoint<D>(file);
+  for (std::size_t p = 0; p < 5; ++p) {
+    EXPECT_EQ(back.particles.position[p], data.particles.position[p]);
+    EXPECT_EQ(back.particles.size0[p], data.particles.size0[p]);
+  }
+
+  // A version-1 checkpoint stored the vectors as n x D (and had no checksum); it still reads.
+  {
+    h5::Handle f(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+    ASSERT_GE(f.get(), 0);
+    h5::write_int64_attribute(f.get(), "version", 1);
+    ASSERT_GE(H5Adelete(f.get(), "checksum"), 0);
+    h5::Handle g = h5::open_group(f.get(), "particles");
+    ASSERT_GE(H5Ldelete(g.get(), "velocity", H5P_DEFAULT), 0);
+    std::vector<double> v;
+    for (const auto& x : data.particles.velocity)
+      for (int a = 0; a < D; ++a) v.push_back(x[a]);
+    h5::write_doubles(g.get(), "velocity", v.data(), 5, D);
+  }
+  const CheckpointData<D> old = read_checkpoint<D>(file);
+  for (std::size_t p = 0; p < 5; ++p) EXPECT_EQ(old.particles.velocity[p], data.particles.velocity[p]);
 }

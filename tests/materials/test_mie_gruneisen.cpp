@@ -107,6 +107,41 @@ TEST(MieGruneisen, ArtificialViscosityActsOnlyInCompression) {
   EXPECT_EQ(tc, td);  // and nothing in expansion
 }
 
+TEST(MieGruneisen, ArtificialViscosityHasTheValueOfSeed004Eq52) {
+  // One step of strong uniaxial compression to J = 0.8 from the same state with and without
+  // viscosity: the Kirchhoff stresses differ by exactly -J q I, with (seed 004 Eq. 52)
+  //     q = rho dx |D_kk| (A1 C + A2 dx |D_kk|),  rho = rho0 / J,
+  // and C the current bulk wave speed, C^2 = dp/drho along the reference Hugoniot
+  // p_H = K eta / (1 - S1 eta)^2, eta = 1 - rho0 / rho (seed 004 Eq. 51 with U = U_H), taken here
+  // by a central difference in rho.
+  const double dt = 1e-6, dx = 2.5e-4, J = 0.8;
+  const double rate = std::log(J) / dt;  // D_kk = rate < 0
+  const double rho0 = 8870.0, K = 188e9, S1 = 1.44;
+  auto p_hugoniot = [&](double rho) {
+    const double eta = 1.0 - rho0 / rho;
+    return K * eta / ((1.0 - S1 * eta) * (1.0 - S1 * eta));
+  };
+  const double rho = rho0 / J, drho = 1e-4 * rho;
+  const double C = std::sqrt((p_hugoniot(rho + drho) - p_hugoniot(rho - drho)) / (2.0 * drho));
+  auto plain = make_material(nickel());
+  for (const auto& [a1, a2] : std::vector<std::pair<double, double>>{{0.4, 0.0}, {0.0, 4.0}, {0.4, 4.0}}) {
+    auto viscous = make_material(nickel(0.0, a1, a2));
+    Point a(*plain), b(*viscous);
+    const Mat3 ta = a.step(*plain, rate, 0.0, dt, dx), tb = b.step(*viscous, rate, 0.0, dt, dx);
+    ASSERT_NEAR(b.F.determinant(), J, 1e-12);
+    const double expected = rho * dx * std::abs(rate) * (a1 * C + a2 * dx * std::abs(rate));
+    const Mat3 diff = ta - tb;  // = J q I
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(diff(i, i) / J, expected, 1e-6 * expected) << "A1 = " << a1 << ", A2 = " << a2;
+      for (int j = 0; j < 3; ++j) {
+        if (j != i) {
+          EXPECT_NEAR(diff(i, j), 0.0, 1e-9 * expected);
+        }
+      }
+    }
+  }
+}
+
 TEST(MieGruneisen, InternalEnergyIsTheStressWork) {
   // U integrates tau : D dt / rho0; for slow elastic compression it matches the cold-curve work.
   auto m = make_material(nickel());

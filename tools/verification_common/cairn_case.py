@@ -23,6 +23,23 @@ from pathlib import Path
 
 import numpy as np
 
+# Exit codes of a case's run script: 0 every assertion holds, 1 the assertions were evaluated and
+# at least one failed (finish()), EXIT_ERROR for anything else: a run that did not complete, a
+# missing binary, an uncaught exception (the hook below). known_failure.py relies on this.
+EXIT_ERROR = 2
+
+
+def _uncaught(kind, value, tb):
+    """An uncaught exception is a crash, not a failed assertion: print it and exit EXIT_ERROR."""
+    import traceback
+    traceback.print_exception(kind, value, tb)
+    print(f"RESULT: ERROR (uncaught {kind.__name__})", flush=True)
+    sys.stderr.flush()
+    os._exit(EXIT_ERROR)
+
+
+sys.excepthook = _uncaught
+
 REPO = Path(__file__).resolve().parents[2]
 VERIFICATION = REPO / "verification"
 
@@ -49,7 +66,8 @@ def parse_args(case: str, description: str | None = None, default_threads: int =
     args.out = Path(args.out).resolve()
     args.out.mkdir(parents=True, exist_ok=True)
     if not os.access(args.cairn, os.X_OK):
-        sys.exit(f"cairn binary not found or not executable: {args.cairn}\nRESULT: FAIL (no binary)")
+        print(f"cairn binary not found or not executable: {args.cairn}\nRESULT: ERROR (no binary)")
+        sys.exit(EXIT_ERROR)
     return args
 
 

@@ -6,7 +6,9 @@ docs/materials.md): behind the shock the material moves with the wall, u_p = v_i
 
     U_s = C0 + S1 u_p,   C0 = sqrt(K / rho0),   p_H = rho0 U_s u_p,   eta = u_p / U_s
 
-so the front is at x_front(t) = L - U_s t in the grid frame.
+so the front is at x_front(t) = L - U_s t in the grid frame. The temperature on the Hugoniot of
+this EOS (hugoniot_temperature) follows from T dS = dE + p dV along the Hugoniot; see
+verification/hugoniot_sweep/README.md for the derivation.
 """
 from __future__ import annotations
 
@@ -23,6 +25,9 @@ GAMMA0 = 2.0
 S1 = 1.44
 G = 76e9          # nickel shear modulus (not given in the seeds; plasticity bounds its effect)
 YIELD = 0.5e9     # nickel-like yield stress: keeps deviatoric stress below 0.5 % of p_H
+CV = 440.0        # heat capacity (J/(kg K)) of the material input below
+CONDUCTIVITY = 90.7  # W/(m K), nickel (not in the seeds), used when conduction is on
+T0 = 298.15       # initial temperature (K)
 LENGTH = 50e-3
 WIDTH = 2.5e-3
 CELL = 0.25e-3
@@ -35,18 +40,38 @@ def hugoniot(v_impact: float) -> tuple[float, float]:
     return RHO0 * us * v_impact, us
 
 
+def hugoniot_temperature(v_impact: float, cv: float = CV, t0: float = T0, n: int = 4000) -> float:
+    """Temperature behind the shock on the reference Hugoniot of this Mie-Grueneisen EOS.
+
+    With Gamma rho = gamma0 rho0 and a constant heat capacity c_v, c_v dT = T dS - c_v T Gamma dV / V,
+    and on the Hugoniot T dS = dE_H + p_H dV with E_H = p_H (V0 - V) / 2. In eta = 1 - V/V0:
+        dT_H/deta = gamma0 T_H + (eta p_H' - p_H) / (2 rho0 c_v),   p_H = K eta / (1 - S1 eta)^2,
+    and eta p_H' - p_H = 2 K S1 eta^2 / (1 - S1 eta)^3, so
+        T_H = exp(gamma0 eta) [T0 + K S1 / (rho0 c_v) int_0^eta exp(-gamma0 s) s^2 / (1 - S1 s)^3 ds].
+    The integral is evaluated with Simpson's rule on n intervals.
+    """
+    _, us = hugoniot(v_impact)
+    eta = v_impact / us
+    s = np.linspace(0.0, eta, n + 1)
+    f = np.exp(-GAMMA0 * s) * s ** 2 / (1.0 - S1 * s) ** 3
+    w = np.ones(n + 1)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    integral = float(np.dot(w, f)) * (eta / n) / 3.0
+    return math.exp(GAMMA0 * eta) * (t0 + K * S1 / (RHO0 * cv) * integral)
+
+
 def case_input(run_dir: Path, v_impact: float, end_time: float, update: str, order: int,
                a1: float = 0.4, a2: float = 4.0, shape: str = "b2cpdi", every: float | None = None,
-               yield_stress: float = YIELD) -> dict:
+               yield_stress: float = YIELD, conduction: bool = False) -> dict:
     d = 1.5
-    return {
+    doc = {
         "simulation": {"title": f"nickel shock {update}({order}) v = {v_impact}", "dimension": 2,
                        "mode": "plane_strain", "end_time": end_time, "cfl": 0.2},
         "grid": {"origin": [-1e-3, -1e-3], "extent": [53e-3, 4.5e-3], "cell_size": CELL},
         "method": {"shape": shape, "update": update, "order": order, "stress_update": "usl"},
         "material": [{"name": "nickel", "model": "mie_gruneisen", "density": RHO0, "bulk_modulus": K,
                       "shear_modulus": G, "gamma0": GAMMA0, "s1": S1, "yield_stress": yield_stress,
-                      "av_a1": a1, "av_a2": a2, "heat_capacity": 440.0, "initial_temperature": 298.15}],
+                      "av_a1": a1, "av_a2": a2, "heat_capacity": CV, "initial_temperature": T0}],
         "body": [{"name": "bar", "material": "nickel",
                   "shape": {"box": {"min": [0.0, 0.0], "max": [LENGTH, WIDTH]}}, "particles_per_cell": 2}],
         "wall": [
@@ -58,12 +83,17 @@ def case_input(run_dir: Path, v_impact: float, end_time: float, update: str, ord
         ],
         "output": {"directory": str(run_dir), "every": every if every else end_time},
     }
+    if conduction:  # seed 000 Sec. 3.5: "coupled heat conduction"
+        doc["thermal"] = {"conduction": True}
+        doc["material"][0]["conductivity"] = CONDUCTIVITY
+    return doc
 
 
-def profile(snapshot: Path):
-    """Pressure along x averaged over the particles of each column (mid-width rows only)."""
-    s = cairn_case.read_snapshot(snapshot, ("position", "pressure"))
-    x, y, p = s["position"][:, 0], s["position"][:, 1], s["pressure"]
+def profile(snapshot: Path, field: str = "pressure"):
+    """A particle field (pressure by default) along x averaged over the particles of each column
+    (mid-width rows only)."""
+    s = cairn_case.read_snapshot(snapshot, ("position", field))
+    x, y, p = s["position"][:, 0], s["position"][:, 1], s[field]
     keep = (y > 0.25 * WIDTH) & (y < 0.75 * WIDTH)
     x, p = x[keep], p[keep]
     bins = np.round(x / (CELL / 2)).astype(int)
@@ -94,3 +124,11 @@ def measure(xs, ps, t, v_impact):
     overshoot = float(np.max(ps[near]) / plateau - 1.0) if np.any(near) else float("nan")
     return {"plateau": plateau, "p_H": p_h, "front": front, "front_theory": front_theory,
             "U_s": us, "overshoot": overshoot}
+
+
+def plateau_mean(xs, values, t, v_impact):
+    """Mean of a profile over the plateau window of measure() (4 cells behind the theoretical
+    front to 4 cells before the wall)."""
+    _, us = hugoniot(v_impact)
+    sel = (xs > LENGTH - us * t + 4 * CELL) & (xs < LENGTH - v_impact * t - 4 * CELL)
+    return float(np.mean(values[sel])) if np.any(sel) else float("nan")

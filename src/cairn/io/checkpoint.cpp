@@ -18,38 +18,38 @@ namespace {
 
 constexpr const char* format_name = "cairn-checkpoint";
 
-// Particle arrays are written from the simulation's own storage: vectors directly (a Vec<D> is D
-// contiguous doubles), matrices (column-major in memory, row-major in the file) through a
-// bounded block buffer, so a checkpoint never holds a second copy of the particles.
+/// Space vectors are stored n x 3 (zero beyond D), the shape snapshots use (format version 2),
+/// written from the simulation's own storage (a Vec<D> is D contiguous doubles) without a copy.
 template <int D>
-void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v) {
+void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, int deflate) {
   static_assert(sizeof(Vec<D>) == D * sizeof(double), "Vec<D> must be D packed doubles");
-  h5::write_doubles(loc, name, v.empty() ? nullptr : v.front().data(), v.size(), D);
+  h5::write_doubles_padded(loc, name, reinterpret_cast<const double*>(v.data()), v.size(), D, 3, deflate);
 }
 
+/// Reads n x 3 (version 2) or n x D (version 1) vectors.
 template <int D>
 std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t n) {
-  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, static_cast<std::size_t>(D)});
+  const std::vector<std::size_t> shape = h5::dataset_shape(loc, name);
+  const std::size_t cols = shape.size() == 2 && shape[1] == 3 ? 3 : static_cast<std::size_t>(D);
+  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, cols});
   std::vector<Vec<D>> v(n);
   for (std::size_t p = 0; p < n; ++p)
-    for (int a = 0; a < D; ++a) v[p][a] = buffer[D * p + a];
+    for (int a = 0; a < D; ++a) v[p][a] = buffer[cols * p + a];
   return v;
 }
 
-void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m) {
-  h5::write_doubles_blocked(loc, name, m.size(), 9, [&](std::size_t first, std::size_t count, double* out) {
-    for (std::size_t p = first; p < first + count; ++p)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
-  });
-}
-
-void write_mats(hid_t loc, const std::string& name, const std::vector<SymMat3>& m) {
-  h5::write_doubles_blocked(loc, name, m.size(), 9, [&](std::size_t first, std::size_t count, double* out) {
-    for (std::size_t p = first; p < first + count; ++p)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
-  });
+// Matrices (column-major or symmetric in memory, row-major 3 x 3 in the file) go through a
+// bounded block buffer, so a checkpoint never holds a second copy of the particles.
+template <class M>
+void write_mats(hid_t loc, const std::string& name, const std::vector<M>& m, int deflate) {
+  h5::write_doubles_blocked(
+      loc, name, m.size(), 9,
+      [&](std::size_t first, std::size_t count, double* out) {
+        for (std::size_t p = first; p < first + count; ++p)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
+      },
+      deflate);
 }
 
 std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
@@ -104,9 +104,9 @@ h5::Handle open_checkpoint(const fs::path& path, int& dimension) {
                              format + "', expected '" + format_name + "')");
   }
   const long long version = h5::read_int64_attribute(root, "version");
-  if (version != checkpoint_format_version) {
+  if (version < 1 || version > checkpoint_format_version) {
     throw std::runtime_error(fmt::format(
-        "checkpoint '{}' has format version {}, but this build of Cairn reads only version {}",
+        "checkpoint '{}' has format version {}, but this build of Cairn reads versions 1 to {}",
         path.string(), version, checkpoint_format_version));
   }
   const long long dim = h5::read_int64_attribute(root, "dimension");
@@ -145,6 +145,9 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     h5::write_double_attribute(root, "previous_dt", data.previous_dt);
     h5::write_int64_attribute(root, "snapshot_next_index", data.snapshot_next_index);
     h5::write_text(root, "config_toml", data.config_toml);
+    OutputMetadata meta = data.metadata;
+    meta.input_toml = data.config_toml;  // input_sha256 fingerprints /config_toml
+    h5::write_metadata(root, meta, false);
     {
       h5::Handle g = h5::create_group(root, "scalars");
       std::vector<std::string> names;
@@ -178,22 +181,23 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     {
       const Particles<D>& ps = particles;
       const std::size_t n = ps.n();
+      const int z = data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
       h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);
-      write_vecs<D>(gid, "position", ps.position);
-      write_vecs<D>(gid, "reference_position", ps.reference_position);
-      write_vecs<D>(gid, "velocity", ps.velocity);
+      write_vecs<D>(gid, "position", ps.position, z);
+      write_vecs<D>(gid, "reference_position", ps.reference_position, z);
+      write_vecs<D>(gid, "velocity", ps.velocity, z);
       h5::write_doubles(gid, "mass", ps.mass.data(), n);
       h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
       if (ps.has_temperature) h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
-      write_vecs<D>(gid, "size0", ps.size0);
-      write_mats(gid, "deformation_gradient", ps.deformation_gradient);
-      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress);
-      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity);
+      write_vecs<D>(gid, "size0", ps.size0, z);
+      write_mats(gid, "deformation_gradient", ps.deformation_gradient, z);
+      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, z);
+      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, z);
       h5::write_ints(gid, "material", ps.material.data(), n);
       h5::write_ints(gid, "body", ps.body.data(), n);
-      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size());
+      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size(), 0, z);
     }
     write_content_checksum(root);  // last: it covers everything above
   });

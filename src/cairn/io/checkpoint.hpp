@@ -4,17 +4,20 @@
 // snapshot listing written so far, and every particle array. Reading it back and continuing
 // gives results identical to a run that was never interrupted. Files are written atomically.
 //
-// File layout (format "cairn-checkpoint", version 1):
+// File layout (format "cairn-checkpoint", version 2; version 1 files are still read):
 //   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index,
-//     checksum (io/checksum.hpp: over everything else; a mismatch is refused on reading)
+//     checksum (io/checksum.hpp: over everything else; a mismatch is refused on reading),
+//     and the metadata of snapshots (cairn_version, title, units, unit_*, input_sha256 of
+//     /config_toml); /material_names, /body_names (string lists)
 //   /config_toml                         scalar string
 //   /scalars/names, /scalars/values      run-loop scalars (string list, doubles)
 //   /history/columns, /history/rows      string list, rows x columns doubles
 //   /snapshots/times, /snapshots/files   snapshot listing (doubles, string list)
 //   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
-//     (n x D), mass, volume0, temperature (n), deformation_gradient, kirchhoff_stress and, for
-//     APIC runs only, affine_velocity (n x 9, row-major), material, body (int32, n),
-//     state (n * n_state_per_particle)
+//     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n,
+//     only for thermal runs), deformation_gradient, kirchhoff_stress and, for APIC runs only,
+//     affine_velocity (n x 9, row-major), material, body (int32, n), state
+//     (n * n_state_per_particle); version 1 files may also hold velocity_gradient (not read)
 #pragma once
 
 #include <filesystem>
@@ -23,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "cairn/io/metadata.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {
@@ -40,10 +44,11 @@ struct CheckpointData {
   std::vector<std::pair<double, std::string>> snapshot_entries;
   int snapshot_next_index = 0;
   Particles<D> particles;
+  OutputMetadata metadata;  ///< written as attributes (units, names, version); not read back
 };
 
 /// Current checkpoint format version written and accepted by this build.
-inline constexpr int checkpoint_format_version = 1;
+inline constexpr int checkpoint_format_version = 2;
 
 /// Write `data` to `path` atomically. Throws std::invalid_argument if the particle arrays have
 /// inconsistent lengths or the history rows differ in length, std::runtime_error on I/O errors.

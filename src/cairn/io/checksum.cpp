@@ -75,11 +75,13 @@ void hash_shape(Hash& h, hid_t space, std::vector<hsize_t>& dims) {
   for (hsize_t d : dims) h.word(d);
 }
 
-/// Variable-length strings: read through a char* memory type and hash their text.
+/// Variable-length strings: read through a char* memory type (of the file type's character set,
+/// ASCII or UTF-8: HDF5 converts between neither) and hash their text.
 template <class Read>
-void hash_vlen_strings(Hash& h, hid_t space, std::size_t count, Read&& read, const std::string& what) {
+void hash_vlen_strings(Hash& h, hid_t type, hid_t space, std::size_t count, Read&& read, const std::string& what) {
   Id mtype{H5Tcopy(H5T_C_S1), H5Tclose};
   H5Tset_size(mtype.id, H5T_VARIABLE);
+  H5Tset_cset(mtype.id, H5Tget_cset(type));
   std::vector<char*> strings(count, nullptr);
   check(read(mtype.id, strings.data()) >= 0, what);
   for (char* s : strings) h.text(s ? std::string(s) : std::string());
@@ -97,7 +99,7 @@ void hash_attribute(Hash& h, hid_t obj, const char* name) {
   hash_shape(h, space.id, dims);
   const auto count = static_cast<std::size_t>(std::max<hssize_t>(H5Sget_simple_extent_npoints(space.id), 0));
   if (H5Tis_variable_str(type.id) > 0) {
-    hash_vlen_strings(h, space.id, count, [&](hid_t m, void* buf) { return H5Aread(attr.id, m, buf); },
+    hash_vlen_strings(h, type.id, space.id, count, [&](hid_t m, void* buf) { return H5Aread(attr.id, m, buf); },
                       std::string("attribute ") + name);
     return;
   }
@@ -129,7 +131,7 @@ void hash_dataset(Hash& h, hid_t dset, const std::string& path) {
   const auto count = static_cast<std::size_t>(std::max<hssize_t>(H5Sget_simple_extent_npoints(space.id), 0));
   if (count == 0) return;
   if (H5Tis_variable_str(type.id) > 0) {
-    hash_vlen_strings(h, space.id, count,
+    hash_vlen_strings(h, type.id, space.id, count,
                       [&](hid_t m, void* buf) { return H5Dread(dset, m, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf); },
                       "dataset " + path);
     return;

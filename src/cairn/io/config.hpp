@@ -34,6 +34,7 @@ struct SimulationConfig {
   long long max_steps = 0;  ///< 0: no limit
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
+  std::string units = "SI"; ///< declared unit system (labels the output; io/units.hpp)
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
   double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
   std::string body_overlap = "error";  ///< bodies sharing space: error | warn
@@ -79,8 +80,9 @@ struct GreyImage;  // io/image.hpp
 struct BodyShapeConfig {
   std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | image
   std::vector<double> min, max;         ///< box
-  std::vector<double> center;           ///< circle, ellipse, annulus, sphere
-  double radius = 0.0;                  ///< circle, sphere
+  std::vector<double> center;           ///< circle, ellipse, annulus, sphere, cylinder
+  double radius = 0.0;                  ///< circle, sphere, cylinder
+  double height = 0.0;                  ///< cylinder (3D, axis along +z from center)
   std::vector<double> semi_axes;        ///< ellipse (2D) / ellipsoid (3D)
   double inner_radius = 0.0, outer_radius = 0.0;  ///< annulus
   std::vector<std::vector<double>> vertices;      ///< polygon (2D)
@@ -231,6 +233,8 @@ struct OutputConfig {
   bool snapshots = true;        ///< write HDF5/XDMF particle snapshots
   bool grid_snapshots = false;  ///< also write node fields
   bool checkpoints = true;
+  double checkpoint_wall_interval = 1800.0;  ///< wall-clock seconds between checkpoints; 0 = off
+  int compression = 0;          ///< gzip level 0-9 of large HDF5 datasets; 0 = off
 };
 
 struct Config {

@@ -30,12 +30,30 @@ Handle simple_space(const std::vector<hsize_t>& dims, hid_t loc, const std::stri
                  "cannot create dataspace for", loc, name);
 }
 
+/// Dataset creation properties: contiguous, or chunked with shuffle + gzip(`deflate`) when
+/// asked for and the dataset is large enough (whole rows per chunk, about 1 MiB).
+Handle creation_properties(const std::vector<hsize_t>& dims, std::size_t element_size, int deflate,
+                           hid_t loc, const std::string& name) {
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "cannot create properties for", loc, name);
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  if (deflate <= 0 || dims.empty() || total < min_compressed_elements) return dcpl;
+  std::vector<hsize_t> chunk = dims;
+  const hsize_t row = total / std::max<hsize_t>(dims[0], 1);
+  chunk[0] = std::clamp<hsize_t>((hsize_t{1} << 20) / (row * element_size), 1, dims[0]);
+  check(H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()), "cannot chunk", loc, name);
+  check(H5Pset_shuffle(dcpl.get()), "cannot set the shuffle filter for", loc, name);
+  check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(std::min(deflate, 9))), "cannot set gzip for", loc, name);
+  return dcpl;
+}
+
 /// Create dataset `name` of file type `ftype` over `dims` and write `data` (memory type `mtype`).
 void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
-                   const std::vector<hsize_t>& dims, const void* data) {
+                   const std::vector<hsize_t>& dims, const void* data, int deflate = 0) {
   Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, H5Tget_size(ftype), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
-                                   H5P_DEFAULT, H5P_DEFAULT),
+                                   dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
@@ -202,26 +220,29 @@ bool has_child(hid_t loc, const std::string& name) {
 }
 
 void write_doubles(hid_t loc, const std::string& name, const double* data, std::size_t rows,
-                   std::size_t cols) {
+                   std::size_t cols, int deflate) {
   std::vector<hsize_t> dims{rows};
   if (cols > 0) dims.push_back(cols);
-  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, deflate);
 }
 
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
-                          const std::vector<std::size_t>& shape) {
+                          const std::vector<std::size_t>& shape, int deflate) {
   std::vector<hsize_t> dims(shape.begin(), shape.end());
-  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data);
+  write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, deflate);
 }
 
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill) {
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
+                           int deflate) {
   const std::vector<hsize_t> dims{rows, cols};
   Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
-                                   H5P_DEFAULT, H5P_DEFAULT),
+                                   dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   if (rows == 0 || cols == 0) return;
+  // 2^17 doubles: the rows of one chunk when compressed (creation_properties), so blocks align.
   const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / cols);
   std::vector<double> buffer(std::min(rows, block) * cols);
   for (std::size_t first = 0; first < rows; first += block) {
@@ -236,8 +257,55 @@ void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows,
   }
 }
 
-void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n) {
-  write_dataset(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, data);
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate) {
+  if (mem_cols == file_cols) {
+    write_doubles(loc, name, data, rows, file_cols, deflate);
+    return;
+  }
+  if (mem_cols > file_cols) fail("more columns in memory than in the file for", loc, name);
+  const std::vector<hsize_t> dims{rows, file_cols};
+  Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
+  const double zero = 0.0;
+  check(H5Pset_fill_value(dcpl.get(), H5T_NATIVE_DOUBLE, &zero), "cannot set the fill value of", loc, name);
+  check(H5Pset_alloc_time(dcpl.get(), deflate > 0 ? H5D_ALLOC_TIME_INCR : H5D_ALLOC_TIME_EARLY),
+        "cannot set the allocation time of", loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                   dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  if (rows == 0 || mem_cols == 0) return;
+  // The first mem_cols columns of the file, from a dense rows x mem_cols array in memory.
+  const hsize_t start[2] = {0, 0}, count[2] = {rows, mem_cols};
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
+        "cannot select columns of", loc, name);
+  Handle mspace = simple_space({rows, mem_cols}, loc, name);
+  check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, mspace.get(), space.get(), H5P_DEFAULT, data),
+        "cannot write dataset", loc, name);
+}
+
+void write_column_view(hid_t loc, const std::string& view, const std::string& source_path,
+                       std::size_t rows, std::size_t source_cols, std::size_t first, std::size_t cols) {
+  Handle vspace = simple_space({rows, cols}, loc, view);
+  Handle sspace = simple_space({rows, source_cols}, loc, view);
+  if (rows > 0) {
+    const hsize_t start[2] = {0, first}, count[2] = {rows, cols};
+    check(H5Sselect_hyperslab(sspace.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
+          "cannot select the source columns of", loc, view);
+  }
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "cannot create properties for", loc, view);
+  if (rows > 0) {
+    check(H5Pset_virtual(dcpl.get(), vspace.get(), ".", source_path.c_str(), sspace.get()),
+          "cannot map the virtual dataset", loc, view);
+  }
+  Handle dset = checked(H5Dcreate2(loc, view.c_str(), H5T_IEEE_F64LE, vspace.get(), H5P_DEFAULT,
+                                   dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, view);
+}
+
+void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n,
+                int deflate) {
+  write_dataset(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, {n}, data, deflate);
 }
 
 void write_text(hid_t loc, const std::string& name, const std::string& text) {
@@ -333,11 +401,13 @@ bool has_attribute(hid_t obj, const std::string& name) {
 }
 
 void write_string_attribute(hid_t obj, const std::string& name, const std::string& value) {
-  Handle type = string_type(value.size(), obj, name);
+  // Variable-length UTF-8: h5py and other readers return it as a str, not as bytes.
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
+  check(H5Tset_size(type.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), "cannot set the character set for", obj, name);
   Handle space = scalar_space(obj, name);
-  std::string buffer = value;
-  buffer.resize(std::max<std::size_t>(value.size(), 1), '\0');
-  write_attribute(obj, name, type.get(), type.get(), space.get(), buffer.data());
+  const char* text = value.c_str();
+  write_attribute(obj, name, type.get(), type.get(), space.get(), &text);
 }
 
 void write_double_attribute(hid_t obj, const std::string& name, double value) {
@@ -364,6 +434,7 @@ std::string read_string_attribute(hid_t obj, const std::string& name) {
   if (H5Tis_variable_str(type.get()) > 0) {
     Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "cannot create string type for", obj, name);
     check(H5Tset_size(mtype.get(), H5T_VARIABLE), "cannot size string type for", obj, name);
+    check(H5Tset_cset(mtype.get(), H5Tget_cset(type.get())), "cannot set the character set for", obj, name);
     char* text = nullptr;
     check(H5Aread(attr.get(), mtype.get(), &text), "cannot read attribute", obj, name);
     std::string value = text != nullptr ? std::string(text) : std::string();

@@ -15,6 +15,10 @@
 #include <string>
 #include <vector>
 
+namespace cairn {
+struct OutputMetadata;
+}
+
 namespace cairn::h5 {
 
 /// Switch off HDF5's automatic printing of its error stack (idempotent, thread-safe).
@@ -64,19 +68,37 @@ class Handle {
 /// Whether `loc` has a direct child link called `name`.
 [[nodiscard]] bool has_child(hid_t loc, const std::string& name);
 
+// `deflate` (0-9, output.compression): datasets of at least `min_compressed_elements` values are
+// stored chunked (about 1 MiB per chunk, whole rows) with the shuffle and gzip filters at that
+// level; 0 stores every dataset contiguous and uncompressed.
+inline constexpr std::size_t min_compressed_elements = 4096;
+
 /// Write a double dataset: 1D of length `rows` if `cols` == 0, else rows x cols (row-major).
 void write_doubles(hid_t loc, const std::string& name, const double* data, std::size_t rows,
-                   std::size_t cols = 0);
+                   std::size_t cols = 0, int deflate = 0);
 /// Write a double dataset of any rank with the given shape (row-major, last index fastest).
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
-                          const std::vector<std::size_t>& shape);
+                          const std::vector<std::size_t>& shape, int deflate = 0);
 /// Write a rows x cols double dataset block by block: fill(first, count, buffer) stores rows
-/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB, so an array
-/// whose memory layout differs from the file's is written without a copy of the whole array.
+/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB (one chunk
+/// when compressed), so an array whose memory layout differs from the file's is written without
+/// a copy of the whole array.
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill);
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
+                           int deflate = 0);
+/// Write a rows x `file_cols` double dataset from rows x `mem_cols` values in memory (row-major,
+/// mem_cols <= file_cols): columns mem_cols.. are zero. Space vectors of D < 3 components are
+/// stored this way with 3 columns, without a padded copy.
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate = 0);
+/// Create `view` below `loc` as an HDF5 virtual dataset showing columns [first, first + cols) of
+/// the rows x source_cols double dataset `source_path` (absolute path in the same file): no data
+/// is copied, and every reader of HDF5 >= 1.10 (h5py, ParaView) sees an ordinary array.
+void write_column_view(hid_t loc, const std::string& view, const std::string& source_path,
+                       std::size_t rows, std::size_t source_cols, std::size_t first, std::size_t cols);
 /// Write a 1D int32 dataset of length `n`.
-void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n);
+void write_ints(hid_t loc, const std::string& name, const std::int32_t* data, std::size_t n,
+                int deflate = 0);
 /// Write a text (any length, no embedded NUL) as a scalar fixed-length string dataset.
 void write_text(hid_t loc, const std::string& name, const std::string& text);
 /// Write a 1D dataset of fixed-length strings.
@@ -96,7 +118,7 @@ void write_text_list(hid_t loc, const std::string& name, const std::vector<std::
 
 /// Whether the object `obj` (file, group or dataset) has an attribute `name`.
 [[nodiscard]] bool has_attribute(hid_t obj, const std::string& name);
-/// Attach a string attribute (fixed-length) to `obj`.
+/// Attach a string attribute (variable-length UTF-8) to `obj`.
 void write_string_attribute(hid_t obj, const std::string& name, const std::string& value);
 /// Attach a scalar double attribute to `obj`.
 void write_double_attribute(hid_t obj, const std::string& name, double value);
@@ -113,7 +135,17 @@ void write_int64_attribute(hid_t obj, const std::string& name, long long value);
 /// Read a scalar integer attribute as int64.
 [[nodiscard]] long long read_int64_attribute(hid_t obj, const std::string& name);
 
+/// Attach "units", "description" and (if not empty) "components" string attributes to the
+/// dataset `name` below `loc` (metadata.cpp).
+void describe_dataset(hid_t loc, const std::string& name, const std::string& units,
+                      const std::string& description, const std::string& components = {});
+
 /// "'<file>:<object path>/<name>'" for error messages.
 [[nodiscard]] std::string describe(hid_t loc, const std::string& name);
+
+/// Root attributes cairn_version, title, units, unit_length, unit_mass, unit_time,
+/// unit_temperature, input_sha256 (of the resolved input), the datasets material_names and
+/// body_names and, if `with_input`, the resolved input as the text dataset `input` (metadata.cpp).
+void write_metadata(hid_t root, const OutputMetadata& meta, bool with_input);
 
 }  // namespace cairn::h5

@@ -897,6 +897,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
+  s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
   s.max_estimated_steps = r.real("max_estimated_steps");
   s.body_overlap = r.string("body_overlap");
@@ -1106,6 +1107,10 @@ BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConf
   } else if (kind == "circle" || kind == "sphere") {
     s.center = r.reals("center", n, false);
     s.radius = r.real("radius");
+  } else if (kind == "cylinder") {
+    s.center = r.reals("center", n, false);
+    s.radius = r.real("radius");
+    s.height = r.real("height");
   } else if (kind == "ellipse") {
     s.center = r.reals("center", n, false);
     s.semi_axes = r.reals("semi_axes", n, false);
@@ -1527,6 +1532,8 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.snapshots = r.boolean("snapshots");
   o.grid_snapshots = r.boolean("grid_snapshots");
   o.checkpoints = r.boolean("checkpoints");
+  o.checkpoint_wall_interval = r.real("checkpoint_wall_interval");
+  o.compression = r.small_integer("compression");
 }
 
 void Loader::read_contact(const toml::table& root, Config& cfg) {
@@ -1651,6 +1658,9 @@ std::string shape_text(const BodyShapeConfig& s) {
     params = fmt::format("center = {}, radius = {}", reals_text(s.center), real_text(s.radius));
   else if (s.kind == "ellipse")
     params = fmt::format("center = {}, semi_axes = {}", reals_text(s.center), reals_text(s.semi_axes));
+  else if (s.kind == "cylinder")
+    params = fmt::format("center = {}, radius = {}, height = {}", reals_text(s.center), real_text(s.radius),
+                         real_text(s.height));
   else if (s.kind == "annulus")
     params = fmt::format("center = {}, inner_radius = {}, outer_radius = {}", reals_text(s.center),
                          real_text(s.inner_radius), real_text(s.outer_radius));
@@ -1681,6 +1691,7 @@ std::string config_to_toml(const Config& c) {
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
+  line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));
   line("max_estimated_steps", real_text(s.max_estimated_steps));
   line("body_overlap", toml_string(s.body_overlap));
@@ -1871,6 +1882,8 @@ std::string config_to_toml(const Config& c) {
   line("snapshots", boolean(out.snapshots));
   line("grid_snapshots", boolean(out.grid_snapshots));
   line("checkpoints", boolean(out.checkpoints));
+  line("checkpoint_wall_interval", real_text(out.checkpoint_wall_interval));
+  line("compression", fmt::format("{}", out.compression));
   return o;
 }
 
@@ -1895,7 +1908,18 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
   if (!in) throw InputError(path, 0, "", "a readable input file", std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  return load_config_string(text.str(), path, overrides);
+  Config cfg = load_config_string(text.str(), path, overrides);
+  // A relative output folder from the file (or the default out/<stem>) lies next to the input
+  // file; one given with --set is relative to the working directory, as typed.
+  bool from_command_line = false;
+  for (const auto& o : overrides)
+    from_command_line = from_command_line || trim(o.substr(0, o.find('='))) == "output.directory";
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!from_command_line && !folder.empty() && std::filesystem::path(cfg.output.directory).is_relative()) {
+    cfg.output.directory = (folder / cfg.output.directory).lexically_normal().string();
+    cfg.resolved_toml = config_to_toml(cfg);
+  }
+  return cfg;
 }
 
 }  // namespace cairn

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <map>
 
+#include "cairn/io/units.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/sim/names.hpp"
 
@@ -116,6 +117,13 @@ std::vector<KeyDecl> make_declarations() {
                  "the input, warn prints a warning naming both and runs.")
                 .by_default("\"error\"")
                 .choices([] { return std::vector<std::string>{"error", "warn"}; }));
+  k.push_back(Key("simulation", "units", T::string,
+                 "Unit system the input's numbers are in. Cairn computes in any consistent set; "
+                 "this labels the output files (SI: m kg s, derived N Pa J; mm_t_s: mm tonne s, "
+                 "N MPa mJ; mm_kg_ms: mm kg ms, kN GPa J; cgs: cm g s, dyn Ba erg; unspecified: "
+                 "dimensions only).")
+                .by_default("\"SI\"")
+                .choices(unit_system_names));
 
   // [grid]
   k.push_back(Key("grid", "origin", T::real_array,
@@ -280,6 +288,17 @@ std::vector<KeyDecl> make_declarations() {
                 .required());
   k.push_back(Key("body.shape.sphere", "radius", T::real,
                  "Radius.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.cylinder", "center", T::real_array,
+                 "Centre [x, y, z] of the bottom face; the axis points along +z.")
+                .required());
+  k.push_back(Key("body.shape.cylinder", "radius", T::real,
+                 "Radius.")
+                .required()
+                .min(above_zero));
+  k.push_back(Key("body.shape.cylinder", "height", T::real,
+                 "Length along z.")
                 .required()
                 .min(above_zero));
   k.push_back(Key("body.shape.image", "file", T::string,
@@ -543,7 +562,8 @@ std::vector<KeyDecl> make_declarations() {
 
   // [output]
   k.push_back(Key("output", "directory", T::string,
-                 "Output folder; \"\" = out/<input file stem>.")
+                 "Output folder; \"\" = out/<input file stem>. A relative folder lies next to the "
+                 "input file (with --set: relative to the working directory).")
                 .by_default("\"\""));
   k.push_back(Key("output", "every", T::real,
                  "Snapshot interval in simulated time; 0 = first and last only.")
@@ -566,6 +586,16 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("output", "checkpoints", T::boolean,
                  "Write checkpoints for `cairn restart`.")
                 .by_default("true"));
+  k.push_back(Key("output", "checkpoint_wall_interval", T::real,
+                 "Wall-clock seconds between checkpoints (checkpoint-autosave.h5, overwritten); "
+                 "0 = none. SIGINT/SIGTERM also write it.")
+                .by_default("1800.0")
+                .min(0.0));
+  k.push_back(Key("output", "compression", T::integer,
+                 "gzip level (1-9) of the large HDF5 datasets (chunked, shuffled); 0 = off.")
+                .by_default("0")
+                .min(0)
+                .max(9));
   return k;
 }
 
@@ -591,6 +621,7 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.circle.center", "real[2]"},
       {"body.shape.annulus.center", "real[2]"},
       {"body.shape.sphere.center", "real[3]"},
+      {"body.shape.cylinder.center", "real[3]"},
       {"body.shape.polygon.vertices", "real[2][n]"},
       {"body.shape.image.origin", "real[2]"},
       {"body.shape.image.levels", "integer[2]"},
@@ -953,6 +984,38 @@ std::string markdown_text() {
 }
 
 /// One aligned block of rows (columns separated by two spaces, the last column not padded).
+/// Width of `cairn keys` (a 100-column terminal).
+constexpr std::size_t plain_width = 100;
+
+/// Word-wrap `text` into lines of at most `width` characters (a longer word is cut).
+std::vector<std::string> wrap(const std::string& text, std::size_t width) {
+  std::vector<std::string> lines;
+  std::string line;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t space = text.find(' ', pos);
+    std::string word = text.substr(pos, space == std::string::npos ? std::string::npos : space - pos);
+    pos = space == std::string::npos ? text.size() : space + 1;
+    if (word.empty()) continue;
+    if (!line.empty() && line.size() + 1 + word.size() > width) {
+      lines.push_back(line);
+      line.clear();
+    }
+    while (word.size() > width) {
+      if (!line.empty()) lines.push_back(line);
+      lines.push_back(word.substr(0, width));
+      word.erase(0, width);
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  if (!line.empty() || lines.empty()) lines.push_back(line);
+  return lines;
+}
+
+/// A table indented by 2 with 2 spaces between columns, at most plain_width wide: the columns
+/// before the last keep their natural width while the last (the doc) has at least 36; then the
+/// widest of them but the first (the key names) gives way; every cell wraps within its column.
 void plain_rows(std::string& out, const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::size_t> width;
   for (const auto& r : rows)
@@ -960,12 +1023,39 @@ void plain_rows(std::string& out, const std::vector<std::vector<std::string>>& r
       if (width.size() <= c) width.push_back(0);
       width[c] = std::max(width[c], r[c].size());
     }
+  if (width.empty()) return;
+  const std::size_t last = width.size() - 1;
+  auto used = [&] {
+    std::size_t u = 2;
+    for (std::size_t c = 0; c < last; ++c) u += width[c] + 2;
+    return u;
+  };
+  // The first column (key names) stays whole, no column gets narrower than its heading or 16.
+  while (used() + 36 > plain_width) {
+    std::size_t widest = 0;
+    for (std::size_t c = 1; c < last; ++c)
+      if (width[c] > std::max<std::size_t>(16, rows[0][c].size()) && (widest == 0 || width[c] > width[widest]))
+        widest = c;
+    if (widest == 0) break;
+    --width[widest];
+  }
+  width[last] = plain_width > used() ? std::max<std::size_t>(plain_width - used(), 20) : 20;
   for (const auto& r : rows) {
-    std::string line = "  ";
-    for (std::size_t c = 0; c < r.size(); ++c)
-      line += c + 1 < r.size() ? fmt::format("{:<{}}  ", r[c], width[c]) : r[c];
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    out += line + "\n";
+    std::vector<std::vector<std::string>> cells;
+    std::size_t height = 1;
+    for (std::size_t c = 0; c < r.size(); ++c) {
+      cells.push_back(wrap(r[c], width[c]));
+      height = std::max(height, cells.back().size());
+    }
+    for (std::size_t k = 0; k < height; ++k) {
+      std::string line = "  ";
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const std::string cell = k < cells[c].size() ? cells[c][k] : "";
+        line += c + 1 < cells.size() ? fmt::format("{:<{}}  ", cell, width[c]) : cell;
+      }
+      while (!line.empty() && line.back() == ' ') line.pop_back();
+      out += line + "\n";
+    }
   }
 }
 
@@ -980,7 +1070,7 @@ std::string plain_text() {
   std::string out =
       "Cairn input keys; D = simulation.dimension. `cairn keys --markdown` gives the full "
       "reference.\n"
-      "Override any key with --set section.key=value; [[material]] and [[body]] entries by "
+      "Override any key with --set section.key=value; [[material]] and [[body]] entries by\n"
       "index: --set material.0.density=1100\n";
   for (const auto& s : section_docs()) {
     out += fmt::format("\n{}\n", s.heading);
@@ -1002,7 +1092,9 @@ std::string plain_text() {
     }
     if (s.name == "body") {
       for (const auto& kind : body_shape_kinds()) {
-        out += fmt::format("\n[[body]] shape = {{ {} = {{ ... }} }}: {}\n", kind.name, kind.doc);
+        out += "\n";
+        for (const auto& line : wrap(fmt::format("[[body]] shape = {{ {} = {{ ... }} }}: {}", kind.name, kind.doc), plain_width))
+          out += line + "\n";
         plain_rows(out, plain_table(copy_section("body.shape." + kind.name)));
       }
     }
@@ -1041,6 +1133,7 @@ const std::vector<BodyShapeKind>& body_shape_kinds() {
       {"annulus", {false, true, false}, "Ring between two concentric circles."},
       {"polygon", {false, true, false}, "Simple polygon."},
       {"sphere", {false, false, true}, "Ball."},
+      {"cylinder", {false, false, true}, "Circular cylinder along z (e.g. a Taylor bar)."},
       {"image", {false, true, false},
        "Pixels of a grey-level PNG picture whose level lies in a range (one body per "
        "material shade)."},

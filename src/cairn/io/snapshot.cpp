@@ -67,8 +67,8 @@ const char* xdmf_header() {
 }  // namespace
 
 template <int D>
-SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem)
-    : directory_(std::move(directory)), stem_(std::move(stem)) {
+SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem, OutputMetadata meta)
+    : directory_(std::move(directory)), stem_(std::move(stem)), meta_(std::move(meta)) {
   if (stem_.empty()) throw std::invalid_argument("snapshot file stem must not be empty");
 }
 
@@ -122,7 +122,9 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   // Derived particle quantities.
   std::vector<double> position(3 * n, 0.0), velocity(3 * n, 0.0), displacement(3 * n, 0.0);
   std::vector<double> volume(n), stress(6 * n), deformation(9 * n), pressure(n), von_mises(n);
+  std::vector<std::int32_t> connectivity(n);
   for (std::size_t p = 0; p < n; ++p) {
+    connectivity[p] = static_cast<std::int32_t>(p);
     for (int a = 0; a < D; ++a) {
       position[3 * p + a] = particles.position[p][a];
       velocity[3 * p + a] = particles.velocity[p][a];
@@ -136,7 +138,8 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
     const double syz = 0.5 * (sigma(1, 2) + sigma(2, 1));
     const double sxz = 0.5 * (sigma(0, 2) + sigma(2, 0));
     const double sxy = 0.5 * (sigma(0, 1) + sigma(1, 0));
-    const double voigt[6] = {sxx, syy, szz, syz, sxz, sxy};
+    // VTK's order of a symmetric tensor, so that ParaView's labels XX YY ZZ XY YZ XZ are right.
+    const double voigt[6] = {sxx, syy, szz, sxy, syz, sxz};
     for (int k = 0; k < 6; ++k) stress[6 * p + k] = voigt[k];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) deformation[9 * p + 3 * i + j] = F(i, j);
@@ -146,74 +149,118 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
                              3.0 * (syz * syz + sxz * sxz + sxy * sxy));
   }
 
-  // Grid node data, stored array order (x fastest) and shape slowest axis first.
+  // Grid node data over the domain nodes j = 0..n_cells per axis (no ghost layers; a periodic
+  // axis repeats its first node at the end), x fastest, shape slowest axis first.
   FileInfo file_info;
   file_info.readable = true;
+  file_info.current = true;
   file_info.n_particles = n;
   std::vector<double> node_mass, node_velocity, node_normal;
   if (with_grid) {
     file_info.has_grid = true;
     file_info.origin.assign(3, 0.0);
     file_info.spacing.assign(3, 1.0);
-    const Vec<D> first = grid->node_position(0);
     for (int a = 0; a < D; ++a) {
-      file_info.origin[a] = first[a];
+      file_info.origin[a] = grid->origin()[a];
       file_info.spacing[a] = grid->cell_size()[a];
     }
-    if (D == 1) file_info.node_shape.push_back(1);
-    for (int a = D - 1; a >= 0; --a) {
-      file_info.node_shape.push_back(static_cast<std::size_t>(grid->stored_nodes(a)));
+    IVec<D> count;
+    std::size_t nn = 1;
+    for (int a = 0; a < D; ++a) {
+      count[a] = grid->n_cells()[a] + 1;
+      nn *= static_cast<std::size_t>(count[a]);
     }
-    const auto nn = static_cast<std::size_t>(grid->n_nodes());
-    node_mass = nodes->mass;
+    for (int a = D - 1; a >= 0; --a) file_info.node_shape.push_back(static_cast<std::size_t>(count[a]));
+    const bool normals = contact_normals && contact_normals->size() == static_cast<std::size_t>(grid->n_nodes());
+    file_info.has_contact_normal = normals;
+    node_mass.assign(nn, 0.0);
     node_velocity.assign(3 * nn, 0.0);
-    for (std::size_t i = 0; i < nn; ++i) {
-      for (int a = 0; a < D; ++a) node_velocity[3 * i + a] = nodes->velocity_new[i][a];
-    }
-    if (contact_normals && contact_normals->size() == nn) {
-      file_info.has_contact_normal = true;
-      node_normal.assign(3 * nn, 0.0);
-      for (std::size_t i = 0; i < nn; ++i)
-        for (int a = 0; a < 3; ++a) node_normal[3 * i + a] = (*contact_normals)[i][a];
+    if (normals) node_normal.assign(3 * nn, 0.0);
+    for (std::size_t k = 0; k < nn; ++k) {
+      IVec<D> j;
+      std::size_t rest = k;
+      for (int a = 0; a < D; ++a) {
+        j[a] = static_cast<int>(rest % static_cast<std::size_t>(count[a]));
+        rest /= static_cast<std::size_t>(count[a]);
+      }
+      const auto i = static_cast<std::size_t>(grid->node_index(j));
+      node_mass[k] = nodes->mass[i];
+      for (int a = 0; a < D; ++a) node_velocity[3 * k + a] = nodes->velocity_new[i][a];
+      if (normals)
+        for (int a = 0; a < 3; ++a) node_normal[3 * k + a] = (*contact_normals)[i][a];
     }
   }
 
   const fs::path target = snapshot_path(next_index_);
+  const int z = meta_.compression;
+  const std::string length = meta_.unit(Quantity::length), vel = meta_.unit(Quantity::velocity);
+  const std::string stress_unit = meta_.unit(Quantity::stress), mass_unit = meta_.unit(Quantity::mass);
   write_file_atomically(target, [&](const fs::path& tmp) {
     h5::Handle file = h5::create_file(tmp);
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", "cairn-snapshot");
+    h5::write_int64_attribute(root, "format_version", snapshot_format_version);
     h5::write_double_attribute(root, "time", time);
+    h5::write_string_attribute(root, "time_units", meta_.unit(Quantity::time));
     h5::write_int64_attribute(root, "step", step);
     h5::write_int64_attribute(root, "dimension", D);
+    h5::write_metadata(root, meta_, true);
     {
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
-      h5::write_doubles(gid, "position", position.data(), n, 3);
-      h5::write_doubles(gid, "velocity", velocity.data(), n, 3);
-      h5::write_doubles(gid, "displacement", displacement.data(), n, 3);
-      h5::write_doubles(gid, "mass", particles.mass.data(), n);
-      h5::write_doubles(gid, "volume", volume.data(), n);
-      h5::write_doubles(gid, "stress", stress.data(), n, 6);
-      h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9);
-      h5::write_doubles(gid, "pressure", pressure.data(), n);
-      h5::write_doubles(gid, "von_mises", von_mises.data(), n);
+      h5::write_doubles(gid, "position", position.data(), n, 3, z);
+      h5::describe_dataset(gid, "position", length, "current position x (zero beyond D)", "x y z");
+      h5::write_doubles(gid, "velocity", velocity.data(), n, 3, z);
+      h5::describe_dataset(gid, "velocity", vel, "velocity v", "x y z");
+      h5::write_doubles(gid, "displacement", displacement.data(), n, 3, z);
+      h5::describe_dataset(gid, "displacement", length, "x - X (current minus reference position)", "x y z");
+      h5::write_doubles(gid, "mass", particles.mass.data(), n, 0, z);
+      h5::describe_dataset(gid, "mass", mass_unit, "particle mass (per unit thickness times the thickness in 2D)");
+      h5::write_doubles(gid, "volume", volume.data(), n, 0, z);
+      h5::describe_dataset(gid, "volume", meta_.unit(Quantity::volume), "current volume det(F) V0");
+      h5::write_doubles(gid, "stress", stress.data(), n, 6, z);
+      h5::describe_dataset(gid, "stress", stress_unit,
+                           "Cauchy stress sigma = tau / det(F), symmetric, VTK order", "xx yy zz xy yz xz");
+      h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9, z);
+      h5::describe_dataset(gid, "deformation_gradient", "1", "F = dx/dX, row-major: F_iJ at 3 i + J",
+                           "xx xy xz yx yy yz zx zy zz");
+      for (int i = 0; i < 3; ++i) {
+        const std::string row = std::string("deformation_gradient_") + "xyz"[i];
+        h5::write_column_view(gid, row, "/particles/deformation_gradient", n, 9, 3 * static_cast<std::size_t>(i), 3);
+        h5::describe_dataset(gid, row, "1", fmt::format("row {} of F (a view of deformation_gradient)", "xyz"[i]),
+                             fmt::format("{0}x {0}y {0}z", "xyz"[i]));
+      }
+      h5::write_doubles(gid, "pressure", pressure.data(), n, 0, z);
+      h5::describe_dataset(gid, "pressure", stress_unit, "-trace(sigma)/3");
+      h5::write_doubles(gid, "von_mises", von_mises.data(), n, 0, z);
+      h5::describe_dataset(gid, "von_mises", stress_unit, "von Mises equivalent stress of sigma");
       std::vector<double> zero;  // runs without a thermal model store no temperatures
       if (particles.temperature.size() != n) zero.assign(n, 0.0);
-      h5::write_doubles(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), n);
-      h5::write_ints(gid, "material", particles.material.data(), n);
-      h5::write_ints(gid, "body", particles.body.data(), n);
+      h5::write_doubles(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), n, 0, z);
+      h5::describe_dataset(gid, "temperature", meta_.unit(Quantity::temperature), "temperature");
+      h5::write_ints(gid, "material", particles.material.data(), n, z);
+      h5::describe_dataset(gid, "material", "1", "index into /material_names");
+      h5::write_ints(gid, "body", particles.body.data(), n, z);
+      h5::describe_dataset(gid, "body", "1", "index into /body_names");
+      h5::write_ints(gid, "connectivity", connectivity.data(), n, z);
+      h5::describe_dataset(gid, "connectivity", "1", "0..n-1: one vertex cell per particle (XDMF Polyvertex)");
     }
     if (with_grid) {
       h5::Handle g = h5::create_group(root, "grid");
       const hid_t gid = g.get();
-      h5::write_doubles_shaped(gid, "node_mass", node_mass.data(), file_info.node_shape);
+      h5::write_doubles_shaped(gid, "node_mass", node_mass.data(), file_info.node_shape, z);
+      h5::describe_dataset(gid, "node_mass", mass_unit, "lumped node mass");
       std::vector<std::size_t> vshape = file_info.node_shape;
       vshape.push_back(3);
-      h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape);
-      if (file_info.has_contact_normal) h5::write_doubles_shaped(gid, "contact_normal", node_normal.data(), vshape);
+      h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape, z);
+      h5::describe_dataset(gid, "node_velocity", vel, "node velocity after the grid update", "x y z");
+      if (file_info.has_contact_normal) {
+        h5::write_doubles_shaped(gid, "contact_normal", node_normal.data(), vshape, z);
+        h5::describe_dataset(gid, "contact_normal", "1", "unit contact normal (zero away from contact)", "x y z");
+      }
       h5::write_doubles_attribute(gid, "origin", file_info.origin);
       h5::write_doubles_attribute(gid, "spacing", file_info.spacing);
+      h5::write_string_attribute(gid, "units", length);
     }
   });
 
@@ -247,12 +294,15 @@ const typename SnapshotWriter<D>::FileInfo& SnapshotWriter<D>::info(const std::s
         fi.n_particles = shape[0];
         fi.readable = true;
       }
+      fi.current = h5::has_attribute(f.get(), "format_version") &&
+                   h5::read_int64_attribute(f.get(), "format_version") == snapshot_format_version;
       if (h5::has_child(f.get(), "grid")) {
         h5::Handle grid = h5::open_group(f.get(), "grid");
         fi.node_shape = h5::dataset_shape(grid.get(), "node_mass");
         fi.origin = h5::read_doubles_attribute(grid.get(), "origin");
         fi.spacing = h5::read_doubles_attribute(grid.get(), "spacing");
-        fi.has_grid = fi.origin.size() == 3 && fi.spacing.size() == 3;
+        fi.has_grid = fi.origin.size() == 3 && fi.spacing.size() == 3 && !fi.node_shape.empty() &&
+                      fi.node_shape.size() <= 3;
         fi.has_contact_normal = h5::has_child(grid.get(), "contact_normal");
       }
     } catch (const std::runtime_error&) {
@@ -268,8 +318,8 @@ void SnapshotWriter<D>::write_xdmf() {
   bool any_grid = false;
   parts.append(std::string_view(xdmf_header()));
   parts.append(std::string_view(
-      "    <!-- stress: Cauchy stress in Voigt order xx, yy, zz, yz, xz, xy; "
-      "deformation_gradient: F row-major -->\n"));
+      "    <!-- stress: Cauchy stress, components XX YY ZZ XY YZ XZ; deformation_gradient_x/y/z: "
+      "rows of F = dx/dX, components X Y Z (docs/output.md) -->\n"));
   fmt::format_to(std::back_inserter(parts),
                  "    <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
                  xml_escape(stem_));
@@ -286,18 +336,26 @@ void SnapshotWriter<D>::write_xdmf() {
                    "      <Grid Name=\"{}\" GridType=\"Uniform\">\n"
                    "        <Time Value=\"{:.17g}\"/>\n"
                    "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
-                   "NodesPerElement=\"1\"/>\n"
-                   "        <Geometry GeometryType=\"XYZ\">\n",
+                   "NodesPerElement=\"1\">\n",
                    grid_name, time, n);
+    // The connectivity makes every XDMF reader build one vertex cell per particle (without it
+    // ParaView's Xdmf3 readers give points but no cells, and nothing is drawn).
+    if (fi.current) hdf_item(parts, "          ", n, true, file, "/particles/connectivity");
+    parts.append(std::string_view("        </Topology>\n        <Geometry GeometryType=\"XYZ\">\n"));
     hdf_item(parts, "          ", n + " 3", false, file, "/particles/position");
     parts.append(std::string_view("        </Geometry>\n"));
     attribute(parts, "velocity", "Vector", n + " 3", false, file, "/particles/velocity");
     attribute(parts, "displacement", "Vector", n + " 3", false, file, "/particles/displacement");
     attribute(parts, "mass", "Scalar", n, false, file, "/particles/mass");
     attribute(parts, "volume", "Scalar", n, false, file, "/particles/volume");
-    attribute(parts, "stress", "Matrix", n + " 6", false, file, "/particles/stress");
-    attribute(parts, "deformation_gradient", "Tensor", n + " 9", false, file,
-              "/particles/deformation_gradient");
+    attribute(parts, "stress", fi.current ? "Tensor6" : "Matrix", n + " 6", false, file, "/particles/stress");
+    if (fi.current) {
+      for (const char* row : {"x", "y", "z"})
+        attribute(parts, std::string("deformation_gradient_") + row, "Vector", n + " 3", false, file,
+                  std::string("/particles/deformation_gradient_") + row);
+    } else {
+      attribute(parts, "deformation_gradient", "Tensor", n + " 9", false, file, "/particles/deformation_gradient");
+    }
     attribute(parts, "pressure", "Scalar", n, false, file, "/particles/pressure");
     attribute(parts, "von_mises", "Scalar", n, false, file, "/particles/von_mises");
     attribute(parts, "temperature", "Scalar", n, false, file, "/particles/temperature");
@@ -307,26 +365,25 @@ void SnapshotWriter<D>::write_xdmf() {
 
     if (!fi.has_grid) continue;
     any_grid = true;
-    const bool three = fi.node_shape.size() == 3;
-    const std::string dims = join(fi.node_shape);
-    // CoRectMesh origin and spacing are listed slowest axis first (z y x), like Dimensions.
-    const std::string origin = three ? fmt::format("{:.17g} {:.17g} {:.17g}", fi.origin[2], fi.origin[1], fi.origin[0])
-                                     : fmt::format("{:.17g} {:.17g}", fi.origin[1], fi.origin[0]);
-    const std::string spacing = three ? fmt::format("{:.17g} {:.17g} {:.17g}", fi.spacing[2], fi.spacing[1], fi.spacing[0])
-                                      : fmt::format("{:.17g} {:.17g}", fi.spacing[1], fi.spacing[0]);
-    const int rank = three ? 3 : 2;
+    // Always a 3D mesh (a 2D grid is one node thick in z, a 1D grid in y and z), so that it lies
+    // in the particles' x-y plane in every reader; Dimensions, origin and spacing are listed
+    // slowest axis first (z y x). The node arrays keep their D-dimensional shape.
+    std::vector<std::size_t> dims3 = fi.node_shape;
+    while (dims3.size() < 3) dims3.insert(dims3.begin(), 1);
+    const std::string dims = join(dims3);
+    const std::string origin = fmt::format("{:.17g} {:.17g} {:.17g}", fi.origin[2], fi.origin[1], fi.origin[0]);
+    const std::string spacing = fmt::format("{:.17g} {:.17g} {:.17g}", fi.spacing[2], fi.spacing[1], fi.spacing[0]);
     fmt::format_to(std::back_inserter(grids),
                    "      <Grid Name=\"{}\" GridType=\"Uniform\">\n"
                    "        <Time Value=\"{:.17g}\"/>\n"
-                   "        <Topology TopologyType=\"{}DCoRectMesh\" Dimensions=\"{}\"/>\n"
-                   "        <Geometry GeometryType=\"{}\">\n"
-                   "          <DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" "
+                   "        <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"{}\"/>\n"
+                   "        <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+                   "          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
                    "Format=\"XML\">{}</DataItem>\n"
-                   "          <DataItem Dimensions=\"{}\" NumberType=\"Float\" Precision=\"8\" "
+                   "          <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
                    "Format=\"XML\">{}</DataItem>\n"
                    "        </Geometry>\n",
-                   grid_name, time, rank, dims, three ? "ORIGIN_DXDYDZ" : "ORIGIN_DXDY", rank,
-                   origin, rank, spacing);
+                   grid_name, time, dims, origin, spacing);
     attribute(grids, "node_mass", "Scalar", dims, false, file, "/grid/node_mass");
     attribute(grids, "node_velocity", "Vector", dims + " 3", false, file, "/grid/node_velocity");
     if (fi.has_contact_normal)
@@ -337,7 +394,38 @@ void SnapshotWriter<D>::write_xdmf() {
   parts.append(footer);
   grids.append(footer);
   write_text_atomically(particles_xdmf_path(), fmt::to_string(parts));
-  if (any_grid) write_text_atomically(grid_xdmf_path(), fmt::to_string(grids));
+  std::error_code ec;
+  if (any_grid) {
+    write_text_atomically(grid_xdmf_path(), fmt::to_string(grids));
+  } else if (fs::exists(grid_xdmf_path(), ec)) {
+    fs::remove(grid_xdmf_path(), ec);  // no listed snapshot has grid data (any more)
+  }
+}
+
+template <int D>
+void SnapshotWriter<D>::restore(std::vector<Entry> entries, int next_index) {
+  set_entries(std::move(entries));
+  set_next_index(next_index);
+  // Files of this series numbered next_index or later belong to the abandoned continuation of
+  // the run: remove them, so that the folder, the XDMF files and history.csv all end at the
+  // restored time.
+  std::error_code ec;
+  const fs::path folder = directory_ / "snapshots";
+  if (fs::is_directory(folder, ec)) {
+    const std::string prefix = stem_ + "-";
+    std::vector<fs::path> stale;
+    for (const auto& e : fs::directory_iterator(folder, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.size() != prefix.size() + 9 || name.compare(0, prefix.size(), prefix) != 0 ||
+          e.path().extension() != ".h5")
+        continue;
+      const std::string digits = name.substr(prefix.size(), 6);
+      if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      if (std::stoi(digits) >= next_index) stale.push_back(e.path());
+    }
+    for (const auto& p : stale) fs::remove(p, ec);
+  }
+  write_xdmf();
 }
 
 template class SnapshotWriter<1>;

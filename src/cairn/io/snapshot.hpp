@@ -7,16 +7,26 @@
 //                                named <stem>-grid.xdmf when stem is not "particles")
 // Every file is written atomically (see atomic_file.hpp).
 //
-// Snapshot file contents (n particles, always padded to 3 space components):
-//   root attributes: time (double), step (int64), dimension (int64), format = "cairn-snapshot"
+// Snapshot file contents (format_version 2; n particles; space vectors always have 3 components,
+// zero beyond D; every dataset carries "units" and "description" attributes, vectors and tensors
+// a "components" attribute; docs/output.md lists everything):
+//   root attributes: format = "cairn-snapshot", format_version, time, time_units, step, dimension,
+//     cairn_version, title, units (the declared system), unit_length/mass/time/temperature,
+//     input_sha256 (SHA-256 of /input); datasets /input (the resolved input TOML),
+//     /material_names, /body_names
 //   /particles/position, velocity, displacement (= x - X)      n x 3
-//   /particles/mass, volume (= det F * volume0), pressure (= -tr(sigma)/3), von_mises   n
-//   /particles/stress                Cauchy sigma = tau / det F, n x 6, Voigt order xx,yy,zz,yz,xz,xy
-//   /particles/deformation_gradient  n x 9, row-major (F00, F01, F02, F10, ...)
-//   /particles/material, body        int32, n
-//   /grid (optional): node_mass (shape [nz,] [ny,] nx; in 1D 1 x nx) and node_velocity (same
-//     shape x 3), over all stored nodes including ghost layers, x fastest; attributes origin and
-//     spacing (position of stored node 0 and the cell size, x y z, padded with 0 and 1).
+//   /particles/mass, volume (= det F * volume0), pressure (= -tr(sigma)/3), von_mises,
+//     temperature                                                 n
+//   /particles/stress                Cauchy sigma = tau / det F, n x 6, xx yy zz xy yz xz (VTK order)
+//   /particles/deformation_gradient  n x 9, row-major (F_xx, F_xy, F_xz, F_yx, ...), and its rows
+//     deformation_gradient_x/_y/_z (n x 3 virtual views, no extra data) for ParaView
+//   /particles/material, body        int32, n (indices into /material_names, /body_names)
+//   /particles/connectivity          int32, 0..n-1 (the XDMF Polyvertex cells)
+//   /grid (optional): node_mass (shape [nz,] [ny,] nx) and node_velocity (same shape x 3) over
+//     the domain nodes j = 0..n_cells per axis (no ghost layers), x fastest; attributes origin
+//     and spacing (x y z, padded with 0 and 1). grid.xdmf shows it as a 3D mesh (one node thick
+//     in the missing directions) in the particles' coordinates.
+// Large datasets are chunked and gzip-compressed when output.compression > 0.
 #pragma once
 
 #include <filesystem>
@@ -26,9 +36,13 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/io/metadata.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {
+
+/// Version of the snapshot layout above (root attribute format_version; 1 had no such attribute).
+inline constexpr int snapshot_format_version = 2;
 
 /// Writes numbered HDF5 snapshots of the particles (and optionally the grid) and keeps the XDMF
 /// index files up to date. Its listing state (entries(), next_index()) can be checkpointed so a
@@ -40,8 +54,9 @@ class SnapshotWriter {
   using Entry = std::pair<double, std::string>;
 
   /// Snapshots go to `directory`/snapshots, index files to `directory`. Nothing is written
-  /// until the first write().
-  explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles");
+  /// until the first write(). `meta` describes the run in every file (units, names, input).
+  explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles",
+                          OutputMetadata meta = {});
 
   /// Write snapshot number next_index() of `particles` at `time`/`step` and rewrite the XDMF
   /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
@@ -64,6 +79,11 @@ class SnapshotWriter {
   /// write(); listed files that no longer exist are then left out of the XDMF.
   void set_entries(std::vector<Entry> entries);
 
+  /// Restart: replace the listing and the next index, delete this series' files numbered
+  /// `next_index` or later (the abandoned continuation of the run) and rewrite the XDMF files
+  /// now, so that they end where the restarted run stands.
+  void restore(std::vector<Entry> entries, int next_index);
+
   /// Path of the snapshot file with the given index.
   [[nodiscard]] std::filesystem::path snapshot_path(int index) const;
   /// Path of the particle XDMF file (<directory>/<stem>.xdmf).
@@ -75,6 +95,7 @@ class SnapshotWriter {
   /// What the XDMF needs to know about one snapshot file.
   struct FileInfo {
     bool readable = false;
+    bool current = false;  ///< written in snapshot_format_version (older files: old XDMF form)
     std::size_t n_particles = 0;
     bool has_grid = false;
     bool has_contact_normal = false;
@@ -87,6 +108,7 @@ class SnapshotWriter {
 
   std::filesystem::path directory_;
   std::string stem_;
+  OutputMetadata meta_;
   int next_index_ = 0;
   std::vector<Entry> entries_;
   std::map<std::string, FileInfo> info_;

@@ -17,7 +17,8 @@
 //    With the Rankine-Hugoniot energy jump U = p eta / (2 rho0) this reduces to the reference
 //    Hugoniot p_H = K eta / (1 - S1 eta)^2, U_s = C0 + S1 u_p, C0 = sqrt(K / rho0).
 //  * artificial viscosity seed 004 Eq. 52 in compression only (D_kk < 0):
-//        q = rho dx |D_kk| (A1 C + A2 dx |D_kk|),  C = current bulk wave speed, rho = rho0 / J.
+//        q = rho dx |D_kk| (A1 C + A2 dx |D_kk|),  rho = rho0 / J, C = current bulk wave speed,
+//        C^2 = dp/drho = J dp/deta / rho along the reference Hugoniot (tested).
 // Internal energy per unit mass U is integrated with the trapezoidal rule from the stress power,
 // dU = (tau_old + tau_new) : D dt / (2 rho0), so it includes plastic and viscous work; the EOS uses
 // the predictor U + tau_old : D dt / rho0. Temperature: dT = -gamma0 J T tr(D) dt (Grueneisen
@@ -81,12 +82,13 @@ class MieGruneisen final : public Material {
     const double d = 1.0 - S1_ * eta;
     return K_ * eta * (1.0 - 0.5 * gamma0_ * eta) / (d * d) + density() * gamma0_ * U;
   }
-  /// Tangent bulk modulus of the cold curve (for wave speeds): d/d eta of K eta / (1 - S1 eta)^2.
+  /// Current bulk modulus rho dp/drho = J dp/deta along the reference Hugoniot (p = K eta in
+  /// tension): the "current bulk wave speed" of seed 004 Eq. 52 is sqrt(of this / rho).
   double bulk_tangent(double J) const {
     const double eta = 1.0 - J;
-    if (eta <= 0.0) return K_;
+    if (eta <= 0.0) return J * K_;
     const double d = 1.0 - S1_ * eta;
-    return K_ * (1.0 + S1_ * eta) / (d * d * d);
+    return J * K_ * (1.0 + S1_ * eta) / (d * d * d);
   }
   double yield_stress(double alpha) const {
     return power_ ? yield_ * std::pow(1.0 + alpha / eps0_, n_) : yield_ + H_ * alpha;

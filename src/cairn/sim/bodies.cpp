@@ -44,6 +44,13 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
     return (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all();
   }
   if (s.kind == "circle" || s.kind == "sphere") return (x - vec(s.center)).norm() <= s.radius;
+  if (s.kind == "cylinder") {
+    if constexpr (D == 3) {
+      const Vec<D> d = x - vec(s.center);
+      return d[2] >= 0.0 && d[2] <= s.height && std::hypot(d[0], d[1]) <= s.radius;
+    }
+    return false;
+  }
   if (s.kind == "ellipse") {
     const Vec<D> d = (x - vec(s.center)).cwiseQuotient(vec(s.semi_axes));
     return d.squaredNorm() <= 1.0;

@@ -1,12 +1,17 @@
 #include "cairn/sim/run.hpp"
 
 #include <fmt/format.h>
+#include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <exception>
+#include <regex>
 
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/run.hpp"
@@ -22,6 +27,62 @@ namespace cairn {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// The signal (SIGINT or SIGTERM) that asked the running loop to stop, 0 while none did. The
+/// handler only stores it; the loop checks it after every step.
+volatile std::sig_atomic_t stop_signal = 0;
+
+extern "C" void request_stop(int signo) { stop_signal = signo; }
+
+/// Installs request_stop for SIGINT and SIGTERM for its lifetime (one-shot: a second signal
+/// during the final checkpoint ends the program the default way) and puts the old handlers back.
+class StopSignals {
+ public:
+  StopSignals() {
+    stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = request_stop;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+/// Remove temporaries `<name>.tmp.<pid>[.<n>]` (atomic_file.hpp) that a killed run left in
+/// `folder`: only regular files whose writing process no longer exists.
+void remove_orphan_temporaries(const std::filesystem::path& folder) {
+  static const std::regex pattern(R"(.+\.tmp\.([0-9]{1,10})(\.[0-9]+)?)");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec)) return;
+  std::vector<std::filesystem::path> orphans;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_regular_file(ec) || entry.is_symlink(ec) || !std::regex_match(name, m, pattern)) continue;
+    const long long pid = std::stoll(m[1].str());
+    const bool alive = pid > 0 && pid <= 0x7fffffff && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+    if (!alive || pid == static_cast<long long>(::getpid())) orphans.push_back(entry.path());
+  }
+  for (const auto& p : orphans) std::filesystem::remove(p, ec);
+}
+
+/// "1 h 02 min", "3 min 20 s", "42 s".
+std::string duration_text(double seconds) {
+  const long long s = std::llround(std::max(0.0, seconds));
+  if (s >= 3600) return fmt::format("{} h {:02d} min", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{} min {:02d} s", s / 60, s % 60);
+  return fmt::format("{} s", s);
+}
 
 const std::vector<std::string> history_columns = {
     "kinetic_energy", "strain_energy", "external_work", "total_energy", "energy_error",
@@ -70,13 +131,16 @@ class Runner {
         options_(options),
         sim_(config),
         dir_(config.output.directory),
-        snapshots_(dir_) {
+        meta_(output_metadata(config)),
+        snapshots_(dir_, "particles", meta_) {
     const auto& out = config_.output;
     const double end = config_.simulation.end_time;
     snapshot_.interval = out.every;
     history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
     checkpoint_.interval = out.checkpoint_every;
     std::filesystem::create_directories(dir_);
+    remove_orphan_temporaries(dir_);
+    remove_orphan_temporaries(dir_ / "snapshots");
   }
 
   /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
@@ -107,13 +171,16 @@ class Runner {
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
     history_writer_.set_rows(data.history_rows);
-    snapshots_.set_entries(data.snapshot_entries);
-    snapshots_.set_next_index(data.snapshot_next_index);
+    // Every output ends where the checkpoint stands, before the first new step.
+    history_writer_.flush();
+    snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
     restarted_ = true;
   }
 
   RunSummary run() {
+    const StopSignals signals;
     const auto start = Clock::now();
+    last_autosave_ = start;
     const long long first_step = sim_.step_count();
     const auto& s = config_.simulation;
     if (!restarted_) {
@@ -149,12 +216,20 @@ class Runner {
         checkpoint_.advance(t);
         write_checkpoint_file();
       }
+      const double wall_interval = config_.output.checkpoint_wall_interval;
+      if (config_.output.checkpoints && wall_interval > 0.0 &&
+          std::chrono::duration<double>(Clock::now() - last_autosave_).count() >= wall_interval) {
+        write_checkpoint_file(true);
+        last_autosave_ = Clock::now();
+      }
+      if (stop_signal != 0) interrupted(static_cast<int>(stop_signal));
       progress(start, first_step);
     }
     if (!wrote_history) write_history_row();
     if (!wrote_snapshot) write_snapshot();
     history_writer_.flush();
     if (config_.output.checkpoints) write_checkpoint_file();
+    progress(start, first_step, true);
     finish_progress();
 
     RunSummary summary;
@@ -221,7 +296,11 @@ class Runner {
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
   }
 
-  void write_checkpoint_file() {
+  /// A numbered checkpoint-NNNN.h5, or (autosave: wall-clock interval, signals) the one
+  /// checkpoint-autosave.h5 that each autosave replaces.
+  void write_checkpoint_file(bool autosave = false) {
+    const std::filesystem::path path =
+        autosave ? dir_ / "checkpoint-autosave.h5" : dir_ / fmt::format("checkpoint-{:04d}.h5", checkpoint_index_++);
     CheckpointData<D> data;
     data.config_toml = config_.resolved_toml;
     data.time = sim_.time();
@@ -234,15 +313,30 @@ class Runner {
                     {"snapshots_done", static_cast<double>(snapshot_.done)},
                     {"history_done", static_cast<double>(history_.done)},
                     {"checkpoints_done", static_cast<double>(checkpoint_.done)},
-                    {"checkpoint_index", static_cast<double>(checkpoint_index_ + 1)}};
+                    {"checkpoint_index", static_cast<double>(checkpoint_index_)}};
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
-    last_checkpoint_ = dir_ / fmt::format("checkpoint-{:04d}.h5", checkpoint_index_++);
-    write_checkpoint<D>(last_checkpoint_, data, sim_.particles());  // no copy of the particles
+    data.metadata = meta_;
+    write_checkpoint<D>(path, data, sim_.particles());  // no copy of the particles
+    last_checkpoint_ = path;
+  }
+
+  /// SIGINT/SIGTERM: keep the history, save the state, say where, and stop.
+  [[noreturn]] void interrupted(int signo) {
+    history_writer_.flush();
+    finish_progress();
+    const char* name = signo == SIGINT ? "SIGINT" : signo == SIGTERM ? "SIGTERM" : "a signal";
+    std::string saved = "no checkpoint written (output.checkpoints = false)";
+    if (config_.output.checkpoints) {
+      write_checkpoint_file(true);
+      saved = fmt::format("state saved in {0}; continue with: cairn restart {0}", last_checkpoint_.string());
+    }
+    throw RunInterrupted(fmt::format("interrupted by {} at step {} (t = {:.6g}); {}; output in {}", name,
+                                     sim_.step_count(), sim_.time(), saved, dir_.string()));
   }
 
   /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
@@ -250,7 +344,7 @@ class Runner {
     history_writer_.flush();
     std::string saved;
     try {
-      SnapshotWriter<D> failure(dir_, "failure");
+      SnapshotWriter<D> failure(dir_, "failure", meta_);
       failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
@@ -262,19 +356,39 @@ class Runner {
                                  sim_.step_count() + 1, sim_.time(), f.what(), saved, dir_.string()));
   }
 
-  void progress(Clock::time_point start, long long first_step) {
+  /// On a terminal: a bar with percentage, step, time, throughput and an ETA from the simulated
+  /// time per wall second smoothed over about 10 s (redrawn at most 4 times a second; `final`
+  /// draws the finished state). Elsewhere: one line per 10 %.
+  void progress(Clock::time_point start, long long first_step, bool final = false) {
     if (options_.quiet) return;
     const auto now = Clock::now();
     const double end = config_.simulation.end_time;
-    const double frac = std::min(1.0, sim_.time() / end);
+    const double frac = final ? 1.0 : std::clamp(sim_.time() / end, 0.0, 1.0);
     if (isatty(fileno(stderr))) {
-      if (now - last_progress_ < std::chrono::milliseconds(250)) return;
-      last_progress_ = now;
+      if (!final && now - last_progress_ < std::chrono::milliseconds(250)) return;
       const double elapsed = std::chrono::duration<double>(now - start).count();
+      if (last_progress_ != Clock::time_point{}) {
+        const double dwall = std::chrono::duration<double>(now - last_progress_).count();
+        const double speed = dwall > 0.0 ? (sim_.time() - last_progress_time_) / dwall : 0.0;
+        const double weight = 1.0 - std::exp(-dwall / 10.0);
+        smoothed_speed_ = smoothed_speed_ > 0.0 ? smoothed_speed_ + weight * (speed - smoothed_speed_) : speed;
+      }
+      last_progress_ = now;
+      last_progress_time_ = sim_.time();
       const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(sim_.particles().n()) / elapsed : 0.0;
-      const double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-      std::fprintf(stderr, "\r  step %lld  t = %.4g  %5.1f%%  ETA %6.1f s  %.3g particle-steps/s   ",
-                   sim_.step_count(), sim_.time(), 100.0 * frac, eta, rate);
+      const std::string eta = final ? "done in " + duration_text(elapsed)
+                              : smoothed_speed_ > 0.0 ? "ETA " + duration_text((end - sim_.time()) / smoothed_speed_)
+                                                      : "ETA ...";
+      const std::string tail = fmt::format(" {:5.1f}%  step {}  t = {:.4g}  {}  {:.3g} p-steps/s", 100.0 * frac,
+                                           sim_.step_count(), sim_.time(), eta, rate);
+      struct winsize ws {};
+      const int columns = ioctl(fileno(stderr), TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
+      const int width = std::clamp(columns - 3 - static_cast<int>(tail.size()) - 1, 0, 40);
+      const int filled = static_cast<int>(std::floor(frac * width));
+      std::string line = width >= 10 ? "[" + std::string(filled, '#') + std::string(width - filled, '-') + "]" : "";
+      line += tail;
+      if (static_cast<int>(line.size()) > columns - 1) line.resize(static_cast<std::size_t>(std::max(columns - 1, 0)));
+      std::fprintf(stderr, "\r%s\033[K", line.c_str());
       progress_shown_ = true;
     } else {
       const int decile = static_cast<int>(10.0 * frac);
@@ -294,6 +408,7 @@ class Runner {
   RunOptions options_;
   Simulation<D> sim_;
   std::filesystem::path dir_;
+  OutputMetadata meta_;
   Schedule history_, snapshot_, checkpoint_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
@@ -304,6 +419,9 @@ class Runner {
   bool restarted_ = false;
   std::filesystem::path last_checkpoint_;
   Clock::time_point last_progress_{};
+  double last_progress_time_ = 0.0;
+  double smoothed_speed_ = 0.0;  ///< simulated time per wall second, smoothed
+  Clock::time_point last_autosave_{};
   int last_decile_ = 0;
   bool progress_shown_ = false;
 };
@@ -359,11 +477,25 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
 
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
                    const RunOptions& options) {
-  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, overrides, options);
+  // The restarted run writes next to the checkpoint it was given (not into the folder stored in
+  // it, which may belong to another run or machine), unless --set output.directory says where.
+  std::vector<std::string> all = overrides;
+  bool directory_given = false;
+  for (const auto& o : overrides) {
+    const std::string key = o.substr(0, o.find('='));
+    directory_given = directory_given || key.find("output.directory") != std::string::npos;
+  }
+  if (!directory_given) {
+    const std::string folder = checkpoint.parent_path().empty() ? std::string(".") : checkpoint.parent_path().string();
+    std::string quoted = "\"";
+    for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+    all.push_back("output.directory=" + quoted + "\"");
+  }
+  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, all, options);
   switch (checkpoint_dimension(checkpoint)) {
-    case 1: return restart_dim<1>(checkpoint, overrides, options);
-    case 2: return restart_dim<2>(checkpoint, overrides, options);
-    default: return restart_dim<3>(checkpoint, overrides, options);
+    case 1: return restart_dim<1>(checkpoint, all, options);
+    case 2: return restart_dim<2>(checkpoint, all, options);
+    default: return restart_dim<3>(checkpoint, all, options);
   }
 }
 

@@ -40,6 +40,13 @@ class RunFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A run stopped by SIGINT or SIGTERM after its current step; the message says where the
+/// checkpoint-autosave.h5 it wrote lies (unless output.checkpoints is false) and how to restart.
+class RunInterrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// Run a validated config from t = 0 (dispatches on simulation.dimension).
 RunSummary run(const Config& config, const RunOptions& options);
 
@@ -50,7 +57,10 @@ RunSummary run(const Config& config, const RunOptions& options);
 std::string time_step_note(const Config& config);
 
 /// Continue from a checkpoint written by run(); `overrides` (`--set`) apply to the stored input.
-/// A restart without overrides ends bit-identical to the run that never stopped.
+/// The output goes to the checkpoint's folder unless an override sets output.directory; there
+/// history.csv and the XDMF files are first cut back to the checkpoint's time (later snapshot
+/// files of the series are deleted). A restart without overrides ends bit-identical to the run
+/// that never stopped.
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
                    const RunOptions& options);
 

@@ -566,8 +566,8 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  // The sum is the energy dissipated relative to the non-dissipative FLIP update (seed 002
-  // Eq. 1.50). The entry loop is compiled with and without the full-mass velocity.
+  // The sum is the energy dissipated relative to the non-dissipative FLIP update (below). The
+  // entry loop is compiled with and without the full-mass velocity.
   auto move = [&](auto full_tag) {
     constexpr bool full = decltype(full_tag)::value;
     return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
@@ -586,8 +586,10 @@ void Simulation<D>::update_particles(double dt) {
       Effective<D> e = scheme.effective(g);
       e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
       const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+      // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+      // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
       const Vec<D> ag_dt = g.Sv_new - g.Sv;
-      const double dissipated = P.mass[p] * (ag_dt - e.A_dt).dot(0.5 * ag_dt + dX / dt);
+      const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
       const Vec<D> x_old = P.position[p];
       P.velocity[p] += e.A_dt;
       P.position[p] += dX;

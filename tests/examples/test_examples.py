@@ -1,0 +1,174 @@
+"""Run every example of examples/ that has no verification case of its own, shortened, and check
+that it shows what its header promises; check that docs/tutorial.md builds disk_wall.toml.
+
+Usage: /usr/bin/python3 test_examples.py <cairn binary> <source dir>
+(two_blocks.toml and nickel_shock.toml are the verification cases two_blocks and nickel_shock.)
+"""
+import csv
+import glob
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+G = 9.81
+
+
+class CheckFailed(Exception):
+    pass
+
+
+def check(cond, message):
+    if not cond:
+        raise CheckFailed(message)
+    print("  ok:", message)
+
+
+def run(cairn, source, example, out, overrides):
+    cmd = [cairn, "run", os.path.join(source, "examples", example), "-q", "--set", f"output.directory={out}"]
+    for o in overrides:
+        cmd += ["--set", o]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    if proc.returncode != 0:
+        raise CheckFailed(f"'{' '.join(cmd)}' exited with {proc.returncode}\n{proc.stdout}\n{proc.stderr}")
+
+
+def history(out):
+    with open(os.path.join(out, "history.csv")) as f:
+        rows = list(csv.DictReader(f))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def snapshots(out):
+    """Per snapshot: time and, per body name, its particles' positions, velocities, masses, von
+    Mises stresses."""
+    result = []
+    for path in sorted(glob.glob(os.path.join(out, "snapshots", "particles-*.h5"))):
+        with h5py.File(path, "r") as f:
+            names = [n.decode() for n in f["body_names"][:]]
+            p = f["particles"]
+            body = p["body"][:]
+            bodies = {}
+            for i, name in enumerate(names):
+                s = body == i
+                bodies[name] = {"x": p["position"][:][s], "v": p["velocity"][:][s], "m": p["mass"][:][s],
+                                "von_mises": p["von_mises"][:][s]}
+            result.append((float(f.attrs["time"]), bodies))
+    return result
+
+
+def mean_velocity(b, axis):
+    return float(np.average(b["v"][:, axis], weights=b["m"]))
+
+
+def disk_wall(cairn, source, out):
+    # 4 mm cells (2 mm in the example) and half the time: the disk has hit the wall and left it.
+    run(cairn, source, "disk_wall.toml", out, ["grid.cell_size=4.0e-3", "simulation.end_time=4.0e-3"])
+    h = history(out)
+    p0, p1 = h["momentum_x"][0], h["momentum_x"][-1]
+    check(p0 > 0 and p1 < -0.5 * p0, f"disk_wall: momentum_x {p0:.4g} -> {p1:.4g} (rebound above half the speed)")
+    check(h["contact_wall_disk_x"].max() > 0, f"disk_wall: the disk pushed the wall (+x), up to {h['contact_wall_disk_x'].max():.4g} N")
+    # docs/output.md describes every column and array this run wrote.
+    with open(os.path.join(source, "docs", "output.md")) as f:
+        doc = f.read()
+    generic = {"contact_wall_disk_x": "contact_<a>_<b>_<axis>", "contact_wall_disk_y": "contact_<a>_<b>_<axis>"}
+    missing = [c for c in h if f"`{generic.get(c, c)}`" not in doc]
+    check(not missing, f"disk_wall: docs/output.md lists every history.csv column (missing: {missing})")
+    with h5py.File(sorted(glob.glob(os.path.join(out, "snapshots", "particles-*.h5")))[-1], "r") as f:
+        names = list(f.attrs) + [k for k in f if k != "particles"] + list(f["particles"])
+    missing = [n for n in names if f"`{n}`" not in doc and f"`/{n}`" not in doc and not n.startswith("deformation_gradient_")]
+    check(not missing, f"disk_wall: docs/output.md lists every snapshot attribute and dataset (missing: {missing})")
+
+
+def falling_cube(cairn, source, out):
+    # One particle per cell and through the first bounce only (0.14 s of 0.25 s).
+    run(cairn, source, "falling_cube_3d.toml", out,
+        ["body.0.particles_per_cell=1", "body.1.particles_per_cell=1", "simulation.end_time=0.14",
+         "output.every=0.02"])
+    snaps = snapshots(out)
+    t, bodies = next((t, b) for t, b in snaps if abs(t - 0.08) < 1e-3)
+    vz = mean_velocity(bodies["cube"], 2)
+    check(abs(vz + G * t) <= 0.01 * G * t, f"falling_cube: free fall, v_z(t = {t:.3f}) = {vz:.4f} m/s vs -g t = {-G * t:.4f}")
+    lowest = min(b["cube"]["x"][:, 2].min() for _, b in snaps)
+    check(lowest >= 0.02, f"falling_cube: the cube's particles stay above the floor (lowest z {lowest:.4f} >= 0.02)")
+    t, bodies = snaps[-1]
+    vz = mean_velocity(bodies["cube"], 2)
+    check(vz > 0.3, f"falling_cube: bounced, v_z(t = {t:.3f}) = {vz:.3f} m/s upwards")
+
+
+def taylor_bar(cairn, source, out):
+    # 1.5 mm cells (0.75 mm in the example) and the first 20 us of 80 us.
+    run(cairn, source, "taylor_bar.toml", out,
+        ["grid.cell_size=1.5e-3", "simulation.end_time=2.0e-5", "output.every=1.0e-5"])
+    (t0, first), (t1, last) = snapshots(out)[0], snapshots(out)[-1]
+
+    def shape(b):
+        x = b["x"]
+        r, z = np.hypot(x[:, 0], x[:, 1]), x[:, 2]
+        return z.max() - z.min(), r[z < z.min() + 1.5e-3].max(), r[z > z.max() - 1.5e-3].max()
+
+    (l0, rb0, rt0), (l1, rb1, rt1) = shape(first["bar"]), shape(last["bar"])
+    check(rb1 > 1.2 * rb0, f"taylor_bar: the impact end spreads, radius {rb0 * 1e3:.3f} -> {rb1 * 1e3:.3f} mm")
+    check(abs(rt1 - rt0) < 0.02 * rt0, f"taylor_bar: the far end keeps its radius, {rt0 * 1e3:.3f} -> {rt1 * 1e3:.3f} mm")
+    check(l1 < 0.95 * l0, f"taylor_bar: the bar shortens, {l0 * 1e3:.2f} -> {l1 * 1e3:.2f} mm")
+    # J2 plasticity caps the deviatoric stress at the yield stress (400 MPa, + 100 MPa per unit
+    # plastic strain): an elastic bar would reach rho c v = 6.7 GPa.
+    vm = last["bar"]["von_mises"].max()
+    check(vm < 1.1 * 500e6, f"taylor_bar: von Mises stress {vm / 1e6:.0f} MPa, capped by plasticity")
+
+
+def friction_block(cairn, source, out):
+    # The first 0.1 s of 0.4 s.
+    run(cairn, source, "friction_block.toml", out, ["simulation.end_time=0.1", "output.every=0.05"])
+    t, bodies = snapshots(out)[-1]
+    dv = 1.0 - mean_velocity(bodies["block"], 0)
+    expected = 0.3 * G * t
+    check(abs(dv - expected) <= 0.1 * expected,
+          f"friction_block: the block lost {dv:.4f} m/s in {t:.3f} s, mu g t = {expected:.4f} (within 10 %)")
+    lowest = bodies["block"]["x"][:, 1].min()
+    check(lowest >= 0.02, f"friction_block: the block stays on the floor (lowest y {lowest:.4f} >= 0.02)")
+
+
+def tutorial(cairn, source, out):
+    """docs/tutorial.md builds examples/disk_wall.toml block by block: its TOML blocks put
+    together must resolve to the same input (the output folder aside)."""
+    with open(os.path.join(source, "docs", "tutorial.md")) as f:
+        blocks = re.findall(r"```toml\n(.*?)```", f.read(), re.S)
+    os.makedirs(out)
+    case = os.path.join(out, "disk.toml")
+    with open(case, "w") as f:
+        f.write("\n".join(blocks))
+
+    def resolved(path):
+        proc = subprocess.run([cairn, "check", path], capture_output=True, text=True, timeout=300)
+        if proc.returncode != 0:
+            raise CheckFailed(f"cairn check {path} exited with {proc.returncode}: {proc.stderr}")
+        return [line for line in proc.stdout.splitlines() if not line.startswith("directory = ")]
+
+    check(resolved(case) == resolved(os.path.join(source, "examples", "disk_wall.toml")),
+          f"tutorial: its {len(blocks)} TOML blocks make examples/disk_wall.toml")
+
+
+def main():
+    if len(sys.argv) < 3:
+        print("usage: test_examples.py <cairn binary> <source dir>", file=sys.stderr)
+        return 2
+    cairn, source = sys.argv[1], sys.argv[2]
+    with tempfile.TemporaryDirectory(prefix="cairn_examples_") as tmp:
+        try:
+            for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block):
+                print(case.__name__)
+                case(cairn, source, os.path.join(tmp, case.__name__))
+        except CheckFailed as e:
+            print(f"FAIL: {e}", file=sys.stderr)
+            return 1
+    print("ok: every example ran and shows what it promises")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

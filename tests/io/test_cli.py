@@ -1,0 +1,241 @@
+"""The cairn command as a user meets it: usage and exit codes, the progress bar on a terminal,
+Ctrl-C and SIGTERM, wall-clock checkpoints, restarts into other folders or from earlier
+checkpoints, output folders relative to the input file, leftovers of killed runs.
+
+Usage: /usr/bin/python3 test_cli.py <cairn binary> <source dir>
+"""
+import csv
+import os
+import pty
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+
+import h5py
+
+CASE = """\
+[simulation]
+dimension = 2
+end_time = {end_time}
+
+[grid]
+origin = [0.0, 0.0]
+extent = [0.04, 0.02]
+cell_size = 5.0e-4
+
+[[material]]
+name = "steel"
+model = "linear_elastic"
+density = 7800.0
+youngs_modulus = 200.0e9
+poissons_ratio = 0.3
+
+[[body]]
+name = "plate"
+material = "steel"
+shape = {{ box = {{ min = [0.005, 0.005], max = [0.035, 0.015] }} }}
+velocity = [10.0, 0.0]
+
+[output]
+directory = "{directory}"
+every = {every}
+"""
+
+
+class CheckFailed(Exception):
+    pass
+
+
+def check(cond, message):
+    if not cond:
+        raise CheckFailed(message)
+    print("  ok:", message)
+
+
+def write_case(path, end_time=2.0e-6, every=5.0e-7, directory=""):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(CASE.format(end_time=end_time, every=every, directory=directory))
+    return path
+
+
+def cairn_run(cairn, args, expect=0, cwd=None):
+    proc = subprocess.run([cairn] + args, capture_output=True, text=True, timeout=600, cwd=cwd)
+    if proc.returncode != expect:
+        raise CheckFailed(f"'cairn {' '.join(args)}' exited with {proc.returncode}, expected {expect}\n"
+                          f"--- stdout ---\n{proc.stdout}\n--- stderr ---\n{proc.stderr}")
+    return proc
+
+
+def history_rows(out):
+    with open(os.path.join(out, "history.csv")) as f:
+        return list(csv.reader(f))[1:]
+
+
+def xdmf_times(path):
+    return [float(t.get("Value")) for t in ET.parse(path).getroot().iter("Time")]
+
+
+def snapshot_files(out):
+    return sorted(f for f in os.listdir(os.path.join(out, "snapshots")) if f.startswith("particles-"))
+
+
+def usage_and_exit_codes(cairn, tmp):
+    for args in ([], ["--bogus"], ["frobnicate"], ["run"], ["run", "a.toml", "--bogus"]):
+        proc = cairn_run(cairn, args, expect=2)
+        check("usage: cairn run INPUT.toml" in proc.stderr,
+              f"'cairn {' '.join(args)}' exits with 2 and prints the usage line")
+    for args in (["--help"], ["--version"]):
+        cairn_run(cairn, args, expect=0)
+    check(True, "--help and --version exit with 0")
+    proc = cairn_run(cairn, ["run", os.path.join(tmp, "missing.toml")], expect=2)
+    check("missing.toml" in proc.stderr, "a missing input file is bad input: exit code 2")
+
+
+def progress_bar(cairn, tmp):
+    case = write_case(os.path.join(tmp, "bar", "case.toml"), end_time=4.0e-6)
+    pid, fd = pty.fork()
+    if pid == 0:  # child: stdout and stderr on the terminal
+        os.execv(cairn, [cairn, "run", case, "-t", "1"])
+    text = b""
+    while True:
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        text += chunk
+    _, status = os.waitpid(pid, 0)
+    text = text.decode(errors="replace")
+    check(os.waitstatus_to_exitcode(status) == 0, "a run on a terminal succeeds")
+    frames = [f for f in re.split(r"\r", text) if "%" in f and "step" in f]
+    check(len(frames) >= 1, f"{len(frames)} progress frames drawn on the terminal")
+    last = frames[-1]
+    check(re.search(r"\[#{10,}\]", last) is not None and "100.0%" in last and "done in" in last,
+          f"the last frame is a full bar at 100 %: {last.strip()[:90]!r}")
+    check(all(re.search(r"\[[#-]+\] +\d+\.\d%", f) for f in frames), "every frame has a bar and a percentage")
+
+
+def interrupts(cairn, tmp):
+    for sig, name in ((signal.SIGINT, "SIGINT"), (signal.SIGTERM, "SIGTERM")):
+        out = os.path.join(tmp, "int_" + name)
+        case = write_case(os.path.join(out, "case.toml"), end_time=4.0e-4, every=1.0e-6)
+        proc = subprocess.Popen([cairn, "run", case, "-q", "-t", "1"], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        deadline = time.time() + 300
+        while not os.path.exists(os.path.join(out, "out", "case", "snapshots", "particles-000002.h5")):
+            if time.time() > deadline or proc.poll() is not None:
+                proc.kill()
+                raise CheckFailed(f"the run to interrupt ended or stalled early: {proc.communicate()}")
+            time.sleep(0.05)
+        proc.send_signal(sig)
+        stdout, stderr = proc.communicate(timeout=300)
+        autosave = os.path.join(out, "out", "case", "checkpoint-autosave.h5")
+        check(proc.returncode == 1, f"{name}: exit code 1")
+        check(f"interrupted by {name}" in stderr and autosave in stderr and "cairn restart" in stderr,
+              f"{name}: says where the checkpoint is: {stderr.strip()[:160]!r}")
+        check(os.path.isfile(autosave), f"{name}: {os.path.basename(autosave)} exists")
+        with h5py.File(autosave, "r") as f:
+            t_stop = float(f.attrs["time"])
+        check(0 < t_stop < 4.0e-4, f"{name}: the checkpoint is at t = {t_stop:.3g}, before the end")
+    # The interrupted run continues from its autosave to the end, as if never stopped.
+    restarted = cairn_run(cairn, ["restart", autosave, "-q", "--set", "simulation.end_time=2.0e-5"])
+    full = os.path.join(tmp, "int_full")
+    cairn_run(cairn, ["run", write_case(os.path.join(full, "case.toml"), end_time=2.0e-5, every=1.0e-6), "-q"])
+    a, b = history_rows(os.path.join(out, "out", "case")), history_rows(os.path.join(full, "out", "case"))
+    check(a[-1] == b[-1], "the restarted run ends bit-identical to an uninterrupted one")
+    del restarted
+
+
+def wall_clock_checkpoints(cairn, tmp):
+    out = os.path.join(tmp, "wall")
+    case = write_case(os.path.join(out, "case.toml"))
+    cairn_run(cairn, ["run", case, "-q", "--set", "output.checkpoint_wall_interval=1e-9"])
+    autosave = os.path.join(out, "out", "case", "checkpoint-autosave.h5")
+    check(os.path.isfile(autosave), "output.checkpoint_wall_interval writes checkpoint-autosave.h5")
+    proc = cairn_run(cairn, ["keys"])
+    check("checkpoint_wall_interval" in proc.stdout and "1800.0" in proc.stdout,
+          "the wall-clock interval is a key, 1800 s by default")
+
+
+def relative_folders_and_restarts(cairn, tmp):
+    # A relative output folder lies next to the input file, whatever the working directory.
+    case = write_case(os.path.join(tmp, "rel", "inputs", "case.toml"), directory="results/a")
+    cairn_run(cairn, ["run", "inputs/case.toml", "-q", "--set", "output.checkpoint_every=1.0e-6"],
+              cwd=os.path.join(tmp, "rel"))
+    first = os.path.join(tmp, "rel", "inputs", "results", "a")
+    check(os.path.isfile(os.path.join(first, "history.csv")), "relative output.directory resolves against the input's folder")
+    cairn_run(cairn, ["run", case, "-q", "--set", "output.directory=cli_out"], cwd=os.path.join(tmp, "rel"))
+    check(os.path.isfile(os.path.join(tmp, "rel", "cli_out", "history.csv")),
+          "--set output.directory is relative to the working directory")
+
+    # A copied checkpoint restarts next to itself; the original folder is left alone.
+    before = {f: os.path.getmtime(os.path.join(first, f)) for f in os.listdir(first) if f != "snapshots"}
+    elsewhere = os.path.join(tmp, "rel", "copy")
+    os.makedirs(elsewhere)
+    shutil.copy(os.path.join(first, "checkpoint-0000.h5"), elsewhere)
+    cairn_run(cairn, ["restart", os.path.join(elsewhere, "checkpoint-0000.h5"), "-q"])
+    check(os.path.isfile(os.path.join(elsewhere, "history.csv")) and os.path.isfile(os.path.join(elsewhere, "particles.xdmf")),
+          "cairn restart writes next to the checkpoint it was given")
+    after = {f: os.path.getmtime(os.path.join(first, f)) for f in before}
+    check(before == after, "the folder stored in the checkpoint is not touched")
+    third = os.path.join(tmp, "rel", "third")
+    cairn_run(cairn, ["restart", os.path.join(elsewhere, "checkpoint-0000.h5"), "-q", "--set", f"output.directory={third}"])
+    check(os.path.isfile(os.path.join(third, "history.csv")), "--set output.directory chooses the restart's folder")
+
+    # Restarting from an earlier checkpoint, every output agrees on where the run stands.
+    with h5py.File(os.path.join(first, "checkpoint-0000.h5"), "r") as f:
+        t_ckpt, step = float(f.attrs["time"]), int(f.attrs["step"])
+    files_before = snapshot_files(first)
+    cairn_run(cairn, ["restart", os.path.join(first, "checkpoint-0000.h5"), "-q", "--set",
+                      f"simulation.max_steps={step}"])
+    rows = history_rows(first)
+    times = xdmf_times(os.path.join(first, "particles.xdmf"))
+    files = snapshot_files(first)
+    check(float(rows[-1][0]) <= t_ckpt and max(times) <= t_ckpt and len(files) == len(times) < len(files_before),
+          f"after a restart from t = {t_ckpt:.3g}: history ends at {float(rows[-1][0]):.3g}, particles.xdmf at "
+          f"{max(times):.3g}, {len(files)} snapshot files (were {len(files_before)})")
+
+
+def orphan_temporaries(cairn, tmp):
+    out = os.path.join(tmp, "orphans", "out")
+    os.makedirs(os.path.join(out, "snapshots"))
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    leftovers = [os.path.join(out, f"history.csv.tmp.{dead.pid}"),
+                 os.path.join(out, "snapshots", f"particles-000003.h5.tmp.{dead.pid}.12345")]
+    alive = os.path.join(out, f"particles.xdmf.tmp.{os.getpid()}")
+    for p in leftovers + [alive]:
+        open(p, "w").close()
+    case = write_case(os.path.join(tmp, "orphans", "case.toml"), directory="out")
+    cairn_run(cairn, ["run", case, "-q"])
+    check(not any(os.path.exists(p) for p in leftovers), "temporaries of a dead run are removed")
+    check(os.path.exists(alive), "a temporary of a live process is kept")
+
+
+def main():
+    if len(sys.argv) < 3:
+        print("usage: test_cli.py <cairn binary> <source dir>", file=sys.stderr)
+        return 2
+    cairn = os.path.abspath(sys.argv[1])
+    with tempfile.TemporaryDirectory(prefix="cairn_cli_") as tmp:
+        try:
+            for case in (usage_and_exit_codes, progress_bar, interrupts, wall_clock_checkpoints,
+                         relative_folders_and_restarts, orphan_temporaries):
+                print(case.__name__)
+                case(cairn, tmp)
+        except (CheckFailed, subprocess.TimeoutExpired) as e:
+            print(f"FAIL: {e}", file=sys.stderr)
+            return 1
+    print("ok: the command line behaves")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
