@@ -1,6 +1,7 @@
 #include "cairn/io/checksum.hpp"
 
 #include <fmt/format.h>
+#include <xxhash.h>
 
 #include <algorithm>
 #include <cstring>
@@ -13,38 +14,29 @@ namespace {
 
 constexpr const char* attribute_name = "checksum";
 
-/// 64-bit hash over 8-byte words: h = (h ^ w) * K, finished with xorshifts.
+/// Streaming 64-bit XXH3 (libxxhash) over the content; texts carry their length so that field
+/// boundaries count (array shapes are hashed before array bytes).
 class Hash {
  public:
+  Hash() : state_(XXH3_createState()) {
+    if (state_ == nullptr || XXH3_64bits_reset(state_) == XXH_ERROR)
+      throw std::runtime_error("checksum: cannot create the XXH3 state");
+  }
+  ~Hash() { XXH3_freeState(state_); }
+  Hash(const Hash&) = delete;
+  Hash& operator=(const Hash&) = delete;
   void bytes(const void* data, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    std::size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-      std::uint64_t w;
-      std::memcpy(&w, p + i, 8);
-      word(w);
-    }
-    if (i < n) {
-      std::uint64_t w = 0;
-      std::memcpy(&w, p + i, n - i);
-      word(w ^ (static_cast<std::uint64_t>(n - i) << 56));
-    }
+    if (n > 0) XXH3_64bits_update(state_, data, n);
   }
   void text(const std::string& s) {
     word(s.size());
     bytes(s.data(), s.size());
   }
-  void word(std::uint64_t w) { h_ = (h_ ^ w) * 0x9E3779B97F4A7C15ull; }
-  [[nodiscard]] std::uint64_t value() const {
-    std::uint64_t h = h_;
-    h ^= h >> 33;
-    h *= 0xFF51AFD7ED558CCDull;
-    h ^= h >> 33;
-    return h;
-  }
+  void word(std::uint64_t w) { XXH3_64bits_update(state_, &w, sizeof w); }
+  [[nodiscard]] std::uint64_t value() const { return XXH3_64bits_digest(state_); }
 
  private:
-  std::uint64_t h_ = 0xCBF29CE484222325ull;
+  XXH3_state_t* state_;
 };
 
 /// Closes an HDF5 id on scope exit.

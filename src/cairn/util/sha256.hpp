@@ -1,4 +1,4 @@
-// SHA-256 digest (FIPS 180-4), used to fingerprint the resolved input in output files.
+// SHA-256 digest (FIPS 180-4, computed by OpenSSL), used to fingerprint the resolved input in output files.
 #pragma once
 
 #include <string>
