@@ -8,7 +8,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
+#include <unistd.h>
 
+#include <cstdlib>
 #include <iostream>
 #include <new>
 
@@ -93,6 +95,14 @@ constexpr int max_threads = 1024;
 }  // namespace
 
 int main(int argc, char** argv) {
+  // OpenMP threads that wait at a barrier sleep instead of spinning, unless the user chose a
+  // policy: spinning makes 2 threads many times slower than 1 when another process is busy on
+  // the machine (docs/performance.md, "Threads on a shared machine"). libgomp reads the policy
+  // when it loads, before main, so the process restarts itself once with it set (same pid).
+  if (std::getenv("OMP_WAIT_POLICY") == nullptr && std::getenv("GOMP_SPINCOUNT") == nullptr) {
+    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    ::execv("/proc/self/exe", argv);  // returns only on failure: go on with the runtime's default
+  }
   CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
   app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
   app.require_subcommand(1);

@@ -8,6 +8,7 @@
 #include "../support/config_builder.hpp"
 #include "cairn/bc/grid_conditions.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
 namespace {
@@ -135,8 +136,7 @@ double face_velocity(const std::string& shape, FaceCondition c) {
   double worst = 0.0;
   for (std::size_t p = 0; p < 2; ++p) {
     Vec<D> u = Vec<D>::Zero();
-    for (std::size_t s = p * cache.stride; s < p * cache.stride + cache.count[p]; ++s)
-      u += cache.weight[s] * v[cache.node[s]];
+    for (const auto& e : stencil_entries(cache, p)) u += e.weight * v[e.node];
     worst = std::max(worst, c == FaceCondition::fixed ? u.norm() : std::abs(u[0]));
   }
   return worst;

@@ -96,8 +96,8 @@ template <int D>
 double max_stress_difference(const Simulation<D>& a, const Simulation<D>& b) {
   double worst = 0.0, scale = 0.0;
   for (std::size_t p = 0; p < a.particles().n(); ++p) {
-    worst = std::max(worst, (a.particles().kirchhoff_stress[p] - b.particles().kirchhoff_stress[p]).norm());
-    scale = std::max(scale, a.particles().kirchhoff_stress[p].norm());
+    worst = std::max(worst, (a.particles().kirchhoff_stress[p].full() - b.particles().kirchhoff_stress[p].full()).norm());
+    scale = std::max(scale, a.particles().kirchhoff_stress[p].full().norm());
   }
   return worst / scale;
 }

@@ -100,7 +100,6 @@ Particles<D> random_particles(std::size_t n, int n_state, std::mt19937_64& rng) 
     ps.size0[p] = vec();
     ps.deformation_gradient[p] = mat();
     ps.kirchhoff_stress[p] = mat() * 1e9;
-    ps.velocity_gradient[p] = mat();
     ps.affine_velocity[p] = mat();
     ps.temperature[p] = 300.0 + u(rng);
     ps.material[p] = k(rng);
@@ -111,7 +110,7 @@ Particles<D> random_particles(std::size_t n, int n_state, std::mt19937_64& rng) 
     ps.position[0][0] = -0.0;
     ps.mass[0] = std::numeric_limits<double>::denorm_min();
     ps.kirchhoff_stress[0](1, 2) = std::numeric_limits<double>::max();
-    ps.velocity_gradient[0](2, 0) = std::numeric_limits<double>::infinity();
+    ps.affine_velocity[0](2, 0) = std::numeric_limits<double>::infinity();
   }
   return ps;
 }
@@ -131,6 +130,12 @@ void expect_mats_identical(const std::vector<Mat3>& a, const std::vector<Mat3>& 
   }
 }
 
+void expect_mats_identical(const std::vector<SymMat3>& a, const std::vector<SymMat3>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t p = 0; p < a.size(); ++p)
+    for (int k = 0; k < 6; ++k) EXPECT_TRUE(same_bits(a[p].voigt()[k], b[p].voigt()[k])) << what << " particle " << p;
+}
+
 template <int D>
 void expect_particles_identical(const Particles<D>& a, const Particles<D>& b) {
   EXPECT_EQ(a.n_state_per_particle, b.n_state_per_particle);
@@ -143,7 +148,6 @@ void expect_particles_identical(const Particles<D>& a, const Particles<D>& b) {
   EXPECT_TRUE(a.mass == b.mass);
   expect_mats_identical(a.deformation_gradient, b.deformation_gradient, "F");
   expect_mats_identical(a.kirchhoff_stress, b.kirchhoff_stress, "tau");
-  expect_mats_identical(a.velocity_gradient, b.velocity_gradient, "grad v");
   expect_mats_identical(a.affine_velocity, b.affine_velocity, "C");
   EXPECT_TRUE(same_bits(a.temperature, b.temperature));
   EXPECT_EQ(a.material, b.material);

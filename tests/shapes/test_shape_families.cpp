@@ -17,6 +17,7 @@
 #include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/sim/names.hpp"
+#include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
 namespace cairn {
@@ -51,8 +52,8 @@ template <int D>
 std::vector<Entry<D>> stencil(const ShapeFamily<D>& fam, const Grid<D>& grid,
                               const TransferCache<D>& c, std::size_t p) {
   std::vector<Entry<D>> out;
-  for (std::size_t s = p * c.stride; s < p * c.stride + c.count[p]; ++s)
-    out.push_back({fam.dof_position(grid, c.node[s]), c.node[s], c.weight[s], c.gradient[s]});
+  for (const auto& e : stencil_entries(c, p))
+    out.push_back({fam.dof_position(grid, e.node), e.node, e.weight, e.gradient});
   return out;
 }
 
@@ -96,13 +97,13 @@ void check_family(const std::string& name, bool periodic, double deform) {
     }
     // The colouring reach must cover every node of the stencil (or P2G would race).
     if (!periodic)
-      for (std::size_t s = p * cache.stride; s < p * cache.stride + cache.count[p]; ++s) {
-        const IVec<D> j = grid.multi_index(cache.node[s]);
+      for_each_entry(cache, p, [&, cell = grid.cell_of(parts.position[p])](std::int32_t node, double, const Vec<D>&) {
+        const IVec<D> j = grid.multi_index(node);
         for (int a = 0; a < D; ++a) {
-          EXPECT_GE(j[a], cache.cell[p][a] - cache.reach_lo[a]) << what << " p=" << p;
-          EXPECT_LE(j[a], cache.cell[p][a] + 1 + cache.reach_hi[a]) << what << " p=" << p;
+          EXPECT_GE(j[a], cell[a] - cache.reach_lo[a]) << what << " p=" << p;
+          EXPECT_LE(j[a], cell[a] + 1 + cache.reach_hi[a]) << what << " p=" << p;
         }
-      }
+      });
   }
 }
 
@@ -131,8 +132,7 @@ TEST(ShapeFamilies, AllFamiliesOfTheIssueAreRegistered) {
 template <int D>
 std::map<std::int32_t, std::pair<double, Vec<D>>> weights_of(const TransferCache<D>& c, std::size_t p) {
   std::map<std::int32_t, std::pair<double, Vec<D>>> out;
-  for (std::size_t s = p * c.stride; s < p * c.stride + c.count[p]; ++s)
-    out[c.node[s]] = {c.weight[s], c.gradient[s]};
+  for (const auto& e : stencil_entries(c, p)) out[e.node] = {e.weight, e.gradient};
   return out;
 }
 
@@ -287,8 +287,9 @@ template <int D>
   int total = 1;
   for (int a = 0; a < D; ++a) total *= n;
   double worst_S = 0.0, worst_G = 0.0;
-  for (std::size_t s = 0; s < c.count[0]; ++s) {
-    const Vec<D> xi = grid.node_position(c.node[s]);
+  const auto entries = stencil_entries(c, 0);
+  for (const auto& e : entries) {
+    const Vec<D> xi = grid.node_position(e.node);
     std::array<double, n_corners> Nc;
     for (int k = 0; k < n_corners; ++k) {
       Vec<D> sgn;
@@ -320,11 +321,11 @@ template <int D>
         G += (RinvT * dM) * Nc[k] / total;
       }
     }
-    worst_S = std::max(worst_S, std::abs(c.weight[s] - S));
-    worst_G = std::max(worst_G, (c.gradient[s] - G).norm());
+    worst_S = std::max(worst_S, std::abs(e.weight - S));
+    worst_G = std::max(worst_G, (e.gradient - G).norm());
   }
-  if (c.count[0] > 0 && worst_S <= 1e-12 && worst_G < 1e-9) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << name << " D=" << D << ": " << c.count[0] << " nodes, worst |dS| "
+  if (!entries.empty() && worst_S <= 1e-12 && worst_G < 1e-9) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << name << " D=" << D << ": " << entries.size() << " nodes, worst |dS| "
                                        << worst_S << " (1e-12 allowed), worst |dG| " << worst_G << " (1e-9)";
 }
 
@@ -489,15 +490,15 @@ TEST(ShapeFamilies, UGimpWeightIsTheExactIntegralOfTheHatOverTheParticle) {
   parts.add(Vec<1>::Constant(0.4321), Vec<1>::Zero(), 1.0, 1.0, Vec<1>::Constant(0.07), 0, 0);
   TransferCache<1> c;
   gimp->build(grid, parts, c);
-  for (std::size_t s = 0; s < c.count[0]; ++s) {
-    const double xi = grid.node_position(c.node[s])[0];
+  for (const auto& e : stencil_entries(c, 0)) {
+    const double xi = grid.node_position(e.node)[0];
     const int n = 20000;
     double integral = 0.0;
     for (int k = 0; k < n; ++k) {
       const double x = 0.4321 - 0.035 + (k + 0.5) * 0.07 / n;
       integral += std::max(0.0, 1.0 - std::abs(x - xi) / 0.1) / n;
     }
-    EXPECT_NEAR(c.weight[s], integral, 1e-8);
+    EXPECT_NEAR(e.weight, integral, 1e-8);
   }
 }
 

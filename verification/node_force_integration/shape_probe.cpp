@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cairn/shapes/shape_family.hpp"
+#include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
 namespace {
@@ -78,20 +79,21 @@ int run(const Options& o) {
   fam->build(grid, parts, cache);
   std::map<std::int32_t, std::pair<double, Vec<D>>> sums;
   for (std::size_t p = 0; p < parts.n(); ++p) {
-    for (std::size_t s = p * cache.stride; s < p * cache.stride + cache.count[p]; ++s) {
+    // Every entry of p's stencil, whatever the cache's layout (list or per-axis tensor factors).
+    for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>& G) {
       if (o.mode == "stencils") {
-        const Vec<D> x = fam->dof_position(grid, cache.node[s]);
+        const Vec<D> x = fam->dof_position(grid, node);
         std::printf("%zu", p);
         for (int a = 0; a < D; ++a) std::printf(" %.17g", x[a]);
-        std::printf(" %.17g", cache.weight[s]);
-        for (int a = 0; a < D; ++a) std::printf(" %.17g", cache.gradient[s][a]);
+        std::printf(" %.17g", S);
+        for (int a = 0; a < D; ++a) std::printf(" %.17g", G[a]);
         std::printf("\n");
       } else {
-        auto& e = sums.try_emplace(cache.node[s], 0.0, Vec<D>::Zero()).first->second;
-        e.first += cache.weight[s] * volume[p];
-        e.second += cache.gradient[s] * volume[p];
+        auto& e = sums.try_emplace(node, 0.0, Vec<D>::Zero()).first->second;
+        e.first += S * volume[p];
+        e.second += G * volume[p];
       }
-    }
+    });
   }
   for (const auto& [node, e] : sums) {
     const Vec<D> x = fam->dof_position(grid, node);

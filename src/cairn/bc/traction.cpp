@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "cairn/io/errors.hpp"
+#include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
 namespace cairn {
@@ -141,10 +142,8 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
                                 ": a loaded face (traction) reaches beyond the stored grid");
   }
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
-    const std::size_t begin = k * static_cast<std::size_t>(cache_.stride);
-    const std::size_t end = begin + cache_.count[k];
     const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
-    for (std::size_t s = begin; s < end; ++s) force[cache_.node[s] + off] += cache_.weight[s] * point_force_[k];
+    for_each_entry(cache_, k, [&](std::int32_t node, double S, const Vec<D>&) { force[node + off] += S * point_force_[k]; });
   }
 }
 
@@ -152,10 +151,10 @@ template <int D>
 double Tractions<D>::power(const std::vector<Vec<D>>& v, const std::vector<std::int32_t>* field_offset) const {
   double w = 0.0;
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
-    const std::size_t begin = k * static_cast<std::size_t>(cache_.stride);
-    const std::size_t end = begin + cache_.count[k];
     const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
-    for (std::size_t s = begin; s < end; ++s) w += cache_.weight[s] * point_force_[k].dot(v[cache_.node[s] + off]);
+    for_each_entry(cache_, k, [&](std::int32_t node, double S, const Vec<D>&) {
+      w += S * point_force_[k].dot(v[node + off]);
+    });
   }
   return w;
 }

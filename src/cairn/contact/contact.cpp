@@ -74,14 +74,13 @@ void df_table(const MethodConfig& method, int ppc, std::vector<double>& s_out, s
     TransferCache<1> cache;
     shape->build(grid, P, cache);
     double m = 0.0, mx = 0.0;
-    for (std::size_t p = 0; p < P.n(); ++p) {
-      const std::size_t b = p * static_cast<std::size_t>(cache.stride);
-      for (std::size_t s = b; s < b + cache.count[p]; ++s)
-        if (cache.node[s] == node0) {
-          m += cache.weight[s];
-          mx += cache.weight[s] * P.position[p][0];
+    for (std::size_t p = 0; p < P.n(); ++p)
+      for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<1>&) {
+        if (node == node0) {
+          m += S;
+          mx += S * P.position[p][0];
         }
-    }
+      });
     if (m <= 1e-12) continue;
     const double s = mx / m;
     if (!s_out.empty() && s <= s_out.back() + 1e-12) continue;  // keep it strictly increasing
@@ -158,18 +157,6 @@ Contact<D>::Contact(const Config& config, const Grid<D>& grid, const Particles<D
 
 template <int D>
 Contact<D>::~Contact() = default;
-
-template <int D>
-void Contact<D>::fill_slots(const Particles<D>& particles, TransferCache<D>& cache) const {
-  cache.slot.resize(cache.node.size());
-  const auto n = static_cast<std::int64_t>(particles.n());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const std::int32_t off = field_of(particles, static_cast<std::size_t>(p)) * n_nodes_;
-    const std::size_t b = static_cast<std::size_t>(p) * static_cast<std::size_t>(cache.stride);
-    for (std::size_t s = b; s < b + cache.count[p]; ++s) cache.slot[s] = cache.node[s] + off;
-  }
-}
 
 template <int D>
 double Contact<D>::cell_width(const Vec3& n) const {
@@ -252,44 +239,42 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
   if (need_gradient_ || need_position_) {
     if (need_gradient_) gradient_.assign(n_slots, Vec<D>::Zero());
     if (need_position_) position_.assign(n_slots, Vec<D>::Zero());
-    scatter(cache, [&](std::int32_t p, std::size_t s) {
-      const std::int32_t slot = cache.slot[s];
-      const std::int32_t node = cache.node[s];
-      if (contact_of_[static_cast<std::size_t>(node)] < 0) return;
-      if (need_gradient_) {
-        const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
-        gradient_[static_cast<std::size_t>(slot)] += V * cache.gradient[s];
-      }
-      if (need_position_)
-        position_[static_cast<std::size_t>(slot)] +=
-            (cache.weight[s] * particles.mass[p]) * offset_from_node(*grid_, node, particles.position[p]);
+    scatter(cache, [&](std::int32_t p, const auto& stencil) {
+      const std::int32_t off = field_of(particles, static_cast<std::size_t>(p)) * n_nodes_;
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+        const std::int32_t slot = node + off;
+        if (contact_of_[static_cast<std::size_t>(node)] < 0) return;
+        if (need_gradient_) {
+          const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
+          gradient_[static_cast<std::size_t>(slot)] += V * G;
+        }
+        if (need_position_)
+          position_[static_cast<std::size_t>(slot)] +=
+              (S * particles.mass[p]) * offset_from_node(*grid_, node, particles.position[p]);
+      });
     });
   }
   // Point clouds: the particles whose stencil holds the contact node (seed 004 Sec. 3.1, Fig. 3A).
   if (need_clouds_) {
     cloud_begin_.assign(nc + 1, 0);
-    for (std::int64_t p = 0; p < np; ++p) {
-      const std::size_t b = static_cast<std::size_t>(p) * static_cast<std::size_t>(cache.stride);
-      for (std::size_t s = b; s < b + cache.count[p]; ++s) {
-        const std::int32_t c = contact_of_[static_cast<std::size_t>(cache.node[s])];
-        if (c >= 0 && cache.weight[s] > 0.0) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
-      }
-    }
+    for (std::int64_t p = 0; p < np; ++p)
+      for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
+        const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
+        if (c >= 0 && S > 0.0) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
+      });
     for (std::size_t c = 0; c < nc; ++c) cloud_begin_[c + 1] += cloud_begin_[c];
     cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
     cloud_weight_.resize(cloud_.size());
     std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
-    for (std::int64_t p = 0; p < np; ++p) {
-      const std::size_t b = static_cast<std::size_t>(p) * static_cast<std::size_t>(cache.stride);
-      for (std::size_t s = b; s < b + cache.count[p]; ++s) {
-        const std::int32_t c = contact_of_[static_cast<std::size_t>(cache.node[s])];
-        if (c >= 0 && cache.weight[s] > 0.0) {
+    for (std::int64_t p = 0; p < np; ++p)
+      for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
+        const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
+        if (c >= 0 && S > 0.0) {
           const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(c)]++);
           cloud_[at] = static_cast<std::int32_t>(p);
-          cloud_weight_[at] = cache.weight[s];
+          cloud_weight_[at] = S;
         }
-      }
-    }
+      });
   }
   // Normals and separations, node by node.
   const ScopedSeconds fit_lap(fit_seconds_);

@@ -2,8 +2,8 @@
 //
 // In multimaterial mode every field (a material or a body, [contact] mode) extrapolates to its
 // own nodal mass and momentum (seed 004 Eq. 5-6). The simulation stores the fields of one node
-// side by side: slot = field * n_nodes + node, and the transfer cache gets a per-entry slot index
-// so that every transfer of the step reads and writes the particle's own field. A node that sees
+// side by side: slot = field * n_nodes + node, and every transfer of the step adds the particle's
+// field offset to its stencil's nodes, so that it reads and writes the particle's own field. A node that sees
 // two or more fields is a contact node. Contact<D> finds those nodes, their normals and
 // separations once per step (prepare), and corrects a nodal field for contact (correct):
 //   - after the extrapolation of momenta: p^a = p^a0 + dp^a, kept as dv^a = dp^a / m^a (Eq. 26);
@@ -39,8 +39,6 @@ class Contact {
   [[nodiscard]] std::int32_t field_of(const Particles<D>& particles, std::size_t p) const {
     return by_body_ ? particles.body[p] : particles.material[p];
   }
-  /// cache.slot[s] = node + field * n_nodes for every stencil entry.
-  void fill_slots(const Particles<D>& particles, TransferCache<D>& cache) const;
 
   /// Find the contact nodes and their normals and separations from the fields' masses
   /// (slots) and the particles (seed 004 Sec. 2.3, 3.1).

@@ -131,19 +131,22 @@ struct NodeField {
   std::vector<Vec<D>> force;         ///< f_i: internal + body + traction
   std::vector<Vec<D>> velocity;      ///< v_i = m^-1 p (after velocity conditions)
   std::vector<Vec<D>> velocity_new;  ///< v_i^+ = m^-1 p^+ (after velocity conditions)
-  std::vector<Vec<D>> reaction;      ///< force exerted by velocity conditions on the node
+  /// Force exerted by velocity conditions on the node (empty in a simulation without conditions).
+  std::vector<Vec<D>> reaction;
   std::vector<Vec<D>> velocity_full; ///< m~_k^-1 q from the full-mass expansion (FMPM/XPIC)
   std::vector<Vec<D>> velocity_work; ///< scratch: projections, re-extrapolated velocities
 
-  void resize(std::int32_t n) {
+  /// n entries of every field; velocity_full and velocity_work only when `scratch` (a step with
+  /// neither a full-mass expansion nor a second stress-update velocity leaves them empty).
+  void resize(std::int32_t n, bool scratch = true) {
     mass.assign(n, 0.0);
     momentum.assign(n, Vec<D>::Zero());
     force.assign(n, Vec<D>::Zero());
     velocity.assign(n, Vec<D>::Zero());
     velocity_new.assign(n, Vec<D>::Zero());
     reaction.assign(n, Vec<D>::Zero());
-    velocity_full.assign(n, Vec<D>::Zero());
-    velocity_work.assign(n, Vec<D>::Zero());
+    velocity_full.assign(scratch ? n : 0, Vec<D>::Zero());
+    velocity_work.assign(scratch ? n : 0, Vec<D>::Zero());
   }
 };
 

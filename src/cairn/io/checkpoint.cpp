@@ -18,7 +18,8 @@ namespace {
 
 constexpr const char* format_name = "cairn-checkpoint";
 
-/// Space vectors are stored n x 3 (zero beyond D), the shape snapshots use (format version 2).
+/// Space vectors are stored n x 3 (zero beyond D), the shape snapshots use (format version 2),
+/// written from the simulation's own storage (a Vec<D> is D contiguous doubles) without a copy.
 template <int D>
 void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, int deflate) {
   static_assert(sizeof(Vec<D>) == D * sizeof(double), "Vec<D> must be D packed doubles");
@@ -37,12 +38,18 @@ std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t n)
   return v;
 }
 
-void write_mats(hid_t loc, const std::string& name, const std::vector<Mat3>& m, int deflate) {
-  std::vector<double> buffer(9 * m.size());
-  for (std::size_t p = 0; p < m.size(); ++p)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) buffer[9 * p + 3 * i + j] = m[p](i, j);
-  h5::write_doubles(loc, name, buffer.data(), m.size(), 9, deflate);
+// Matrices (column-major or symmetric in memory, row-major 3 x 3 in the file) go through a
+// bounded block buffer, so a checkpoint never holds a second copy of the particles.
+template <class M>
+void write_mats(hid_t loc, const std::string& name, const std::vector<M>& m, int deflate) {
+  h5::write_doubles_blocked(
+      loc, name, m.size(), 9,
+      [&](std::size_t first, std::size_t count, double* out) {
+        for (std::size_t p = first; p < first + count; ++p)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
+      },
+      deflate);
 }
 
 std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
@@ -60,8 +67,8 @@ void check_particles(const Particles<D>& ps) {
   const bool ok = ps.reference_position.size() == n && ps.velocity.size() == n &&
                   ps.mass.size() == n && ps.volume0.size() == n && ps.size0.size() == n &&
                   ps.deformation_gradient.size() == n && ps.kirchhoff_stress.size() == n &&
-                  ps.velocity_gradient.size() == n && ps.affine_velocity.size() == n &&
-                  ps.temperature.size() == n &&
+                  ps.affine_velocity.size() == (ps.has_affine ? n : 0) &&
+                  ps.temperature.size() == (ps.has_temperature ? n : 0) &&
                   ps.material.size() == n &&
                   ps.body.size() == n && ps.n_state_per_particle >= 0 &&
                   ps.state.size() == n * static_cast<std::size_t>(ps.n_state_per_particle);
@@ -114,7 +121,12 @@ h5::Handle open_checkpoint(const fs::path& path, int& dimension) {
 
 template <int D>
 void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
-  check_particles(data.particles);
+  write_checkpoint(path, data, data.particles);
+}
+
+template <int D>
+void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const Particles<D>& particles) {
+  check_particles(particles);
   const std::size_t n_rows = data.history_rows.size();
   const std::size_t n_cols = n_rows > 0 ? data.history_rows.front().size() : data.history_columns.size();
   for (const auto& row : data.history_rows) {
@@ -167,7 +179,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
       h5::write_text_list(g.get(), "files", files);
     }
     {
-      const Particles<D>& ps = data.particles;
+      const Particles<D>& ps = particles;
       const std::size_t n = ps.n();
       const int z = data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
@@ -178,12 +190,11 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
       write_vecs<D>(gid, "velocity", ps.velocity, z);
       h5::write_doubles(gid, "mass", ps.mass.data(), n);
       h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
-      h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
+      if (ps.has_temperature) h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
       write_vecs<D>(gid, "size0", ps.size0, z);
       write_mats(gid, "deformation_gradient", ps.deformation_gradient, z);
       write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, z);
-      write_mats(gid, "velocity_gradient", ps.velocity_gradient, z);
-      write_mats(gid, "affine_velocity", ps.affine_velocity, z);
+      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, z);
       h5::write_ints(gid, "material", ps.material.data(), n);
       h5::write_ints(gid, "body", ps.body.data(), n);
       h5::write_doubles(gid, "state", ps.state.data(), ps.state.size(), 0, z);
@@ -257,12 +268,16 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
     ps.velocity = read_vecs<D>(gid, "velocity", n);
     ps.mass = h5::read_doubles(gid, "mass", {n});
     ps.volume0 = h5::read_doubles(gid, "volume0", {n});
-    ps.temperature = h5::read_doubles(gid, "temperature", {n});
+    ps.has_temperature = h5::has_child(gid, "temperature");
+    if (ps.has_temperature) ps.temperature = h5::read_doubles(gid, "temperature", {n});
     ps.size0 = read_vecs<D>(gid, "size0", n);
     ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
-    ps.kirchhoff_stress = read_mats(gid, "kirchhoff_stress", n);
-    ps.velocity_gradient = read_mats(gid, "velocity_gradient", n);
-    ps.affine_velocity = read_mats(gid, "affine_velocity", n);
+    const std::vector<Mat3> tau = read_mats(gid, "kirchhoff_stress", n);
+    ps.kirchhoff_stress.assign(tau.begin(), tau.end());
+    // APIC runs store C_p; others leave it out (older files also hold velocity_gradient,
+    // which is recomputed every step and not read).
+    ps.has_affine = h5::has_child(gid, "affine_velocity");
+    if (ps.has_affine) ps.affine_velocity = read_mats(gid, "affine_velocity", n);
     ps.material = h5::read_ints(gid, "material", n);
     ps.body = h5::read_ints(gid, "body", n);
     ps.state = h5::read_doubles(gid, "state", {n * static_cast<std::size_t>(n_state)});
@@ -279,6 +294,9 @@ int checkpoint_dimension(const fs::path& path) {
 template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&);
 template void write_checkpoint<2>(const fs::path&, const CheckpointData<2>&);
 template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&);
+template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&, const Particles<1>&);
+template void write_checkpoint<2>(const fs::path&, const CheckpointData<2>&, const Particles<2>&);
+template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&, const Particles<3>&);
 template CheckpointData<1> read_checkpoint<1>(const fs::path&);
 template CheckpointData<2> read_checkpoint<2>(const fs::path&);
 template CheckpointData<3> read_checkpoint<3>(const fs::path&);

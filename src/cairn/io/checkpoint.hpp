@@ -14,8 +14,10 @@
 //   /history/columns, /history/rows      string list, rows x columns doubles
 //   /snapshots/times, /snapshots/files   snapshot listing (doubles, string list)
 //   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
-//     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0 (n), deformation_gradient, kirchhoff_stress, velocity_gradient
-//     (n x 9, row-major), material, body (int32, n), state (n * n_state_per_particle)
+//     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n,
+//     only for thermal runs), deformation_gradient, kirchhoff_stress and, for APIC runs only,
+//     affine_velocity (n x 9, row-major), material, body (int32, n), state
+//     (n * n_state_per_particle); version 1 files may also hold velocity_gradient (not read)
 #pragma once
 
 #include <filesystem>
@@ -52,6 +54,11 @@ inline constexpr int checkpoint_format_version = 2;
 /// inconsistent lengths or the history rows differ in length, std::runtime_error on I/O errors.
 template <int D>
 void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data);
+/// The same with the particles taken from `particles` (data.particles is not read), so that a
+/// running simulation is checkpointed without copying its particle arrays.
+template <int D>
+void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data,
+                      const Particles<D>& particles);
 
 /// Read a checkpoint written by write_checkpoint<D>. Throws std::runtime_error with a clear
 /// message if the file is missing, not HDF5, not a Cairn checkpoint, of another format version,
@@ -65,6 +72,9 @@ int checkpoint_dimension(const std::filesystem::path& path);
 extern template void write_checkpoint<1>(const std::filesystem::path&, const CheckpointData<1>&);
 extern template void write_checkpoint<2>(const std::filesystem::path&, const CheckpointData<2>&);
 extern template void write_checkpoint<3>(const std::filesystem::path&, const CheckpointData<3>&);
+extern template void write_checkpoint<1>(const std::filesystem::path&, const CheckpointData<1>&, const Particles<1>&);
+extern template void write_checkpoint<2>(const std::filesystem::path&, const CheckpointData<2>&, const Particles<2>&);
+extern template void write_checkpoint<3>(const std::filesystem::path&, const CheckpointData<3>&, const Particles<3>&);
 extern template CheckpointData<1> read_checkpoint<1>(const std::filesystem::path&);
 extern template CheckpointData<2> read_checkpoint<2>(const std::filesystem::path&);
 extern template CheckpointData<3> read_checkpoint<3>(const std::filesystem::path&);

@@ -232,6 +232,31 @@ void write_doubles_shaped(hid_t loc, const std::string& name, const double* data
   write_dataset(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, dims, data, deflate);
 }
 
+void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
+                           int deflate) {
+  const std::vector<hsize_t> dims{rows, cols};
+  Handle space = simple_space(dims, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                   dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  if (rows == 0 || cols == 0) return;
+  // 2^17 doubles: the rows of one chunk when compressed (creation_properties), so blocks align.
+  const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / cols);
+  std::vector<double> buffer(std::min(rows, block) * cols);
+  for (std::size_t first = 0; first < rows; first += block) {
+    const std::size_t count = std::min(block, rows - first);
+    fill(first, count, buffer.data());
+    const hsize_t start[2] = {first, 0}, extent[2] = {count, cols};
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, extent, nullptr),
+          "cannot select rows of", loc, name);
+    Handle memory = simple_space({count, cols}, loc, name);
+    check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, buffer.data()),
+          "cannot write dataset", loc, name);
+  }
+}
+
 void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
                           std::size_t mem_cols, std::size_t file_cols, int deflate) {
   if (mem_cols == file_cols) {

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,13 @@ void write_doubles(hid_t loc, const std::string& name, const double* data, std::
 /// Write a double dataset of any rank with the given shape (row-major, last index fastest).
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
                           const std::vector<std::size_t>& shape, int deflate = 0);
+/// Write a rows x cols double dataset block by block: fill(first, count, buffer) stores rows
+/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB (one chunk
+/// when compressed), so an array whose memory layout differs from the file's is written without
+/// a copy of the whole array.
+void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
+                           int deflate = 0);
 /// Write a rows x `file_cols` double dataset from rows x `mem_cols` values in memory (row-major,
 /// mem_cols <= file_cols): columns mem_cols.. are zero. Space vectors of D < 3 components are
 /// stored this way with 3 columns, without a padded copy.

@@ -133,7 +133,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
     const Mat3& F = particles.deformation_gradient[p];
     const double J = F.determinant();
     volume[p] = J * particles.volume0[p];
-    const Mat3 sigma = particles.kirchhoff_stress[p] / J;
+    const Mat3 sigma = particles.kirchhoff_stress[p].full() / J;
     const double sxx = sigma(0, 0), syy = sigma(1, 1), szz = sigma(2, 2);
     const double syz = 0.5 * (sigma(1, 2) + sigma(2, 1));
     const double sxz = 0.5 * (sigma(0, 2) + sigma(2, 0));
@@ -234,7 +234,9 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       h5::describe_dataset(gid, "pressure", stress_unit, "-trace(sigma)/3");
       h5::write_doubles(gid, "von_mises", von_mises.data(), n, 0, z);
       h5::describe_dataset(gid, "von_mises", stress_unit, "von Mises equivalent stress of sigma");
-      h5::write_doubles(gid, "temperature", particles.temperature.data(), n, 0, z);
+      std::vector<double> zero;  // runs without a thermal model store no temperatures
+      if (particles.temperature.size() != n) zero.assign(n, 0.0);
+      h5::write_doubles(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), n, 0, z);
       h5::describe_dataset(gid, "temperature", meta_.unit(Quantity::temperature), "temperature");
       h5::write_ints(gid, "material", particles.material.data(), n, z);
       h5::describe_dataset(gid, "material", "1", "index into /material_names");

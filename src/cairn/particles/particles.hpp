@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "cairn/math/sym_mat3.hpp"
 #include "cairn/math/types.hpp"
 
 namespace cairn {
@@ -20,15 +21,21 @@ struct Particles {
   std::vector<double> volume0;          ///< initial volume V_p^(0) (x thickness in 2D)
   std::vector<Vec<D>> size0;            ///< initial particle edge lengths l_p0 (domain size)
   std::vector<Mat3> deformation_gradient;  ///< F (3x3 always)
-  std::vector<Mat3> kirchhoff_stress;   ///< tau = J sigma (3x3 always)
-  std::vector<Mat3> velocity_gradient;  ///< last grad V_p extrapolated from the grid (diagnostic)
-  std::vector<Mat3> affine_velocity;    ///< APIC affine matrix C_p (top-left DxD used; else zero)
-  std::vector<double> temperature;      ///< temperature (thermal models; 0 where unused)
+  std::vector<SymMat3> kirchhoff_stress;  ///< tau = J sigma (symmetric, six components)
+  /// APIC affine matrix C_p (top-left DxD used); stored only when has_affine, else empty.
+  std::vector<Mat3> affine_velocity;
+  std::vector<double> temperature;      ///< temperature; stored only when has_temperature
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
   std::vector<double> state;
   int n_state_per_particle = 0;
+  /// Whether affine_velocity is stored (the simulation sets it from its scheme before adding
+  /// particles; schemes without an affine part leave the 72 bytes per particle unallocated).
+  bool has_affine = true;
+  /// Whether temperature is stored (thermal models, conduction); the simulation sets it like
+  /// has_affine. Without it the array stays empty and temperatures read as 0.
+  bool has_temperature = true;
 
   [[nodiscard]] std::size_t n() const { return position.size(); }
 
@@ -40,13 +47,29 @@ struct Particles {
     volume0.resize(n);
     size0.resize(n);
     deformation_gradient.resize(n, Mat3::Identity());
-    kirchhoff_stress.resize(n, Mat3::Zero());
-    velocity_gradient.resize(n, Mat3::Zero());
-    affine_velocity.resize(n, Mat3::Zero());
-    temperature.resize(n, 0.0);
+    kirchhoff_stress.resize(n);
+    affine_velocity.resize(has_affine ? n : 0, Mat3::Zero());
+    temperature.resize(has_temperature ? n : 0, 0.0);
     material.resize(n);
     body.resize(n);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
+  }
+
+  /// Release the spare capacity that adding particles one by one leaves (up to half the arrays).
+  void shrink_to_fit() {
+    position.shrink_to_fit();
+    reference_position.shrink_to_fit();
+    velocity.shrink_to_fit();
+    mass.shrink_to_fit();
+    volume0.shrink_to_fit();
+    size0.shrink_to_fit();
+    deformation_gradient.shrink_to_fit();
+    kirchhoff_stress.shrink_to_fit();
+    affine_velocity.shrink_to_fit();
+    temperature.shrink_to_fit();
+    material.shrink_to_fit();
+    body.shrink_to_fit();
+    state.shrink_to_fit();
   }
 
   /// Append one particle; F = I, zero stress.
@@ -59,10 +82,9 @@ struct Particles {
     volume0.push_back(vol0);
     size0.push_back(lp0);
     deformation_gradient.push_back(Mat3::Identity());
-    kirchhoff_stress.push_back(Mat3::Zero());
-    velocity_gradient.push_back(Mat3::Zero());
-    affine_velocity.push_back(Mat3::Zero());
-    temperature.push_back(0.0);
+    kirchhoff_stress.emplace_back();
+    if (has_affine) affine_velocity.push_back(Mat3::Zero());
+    if (has_temperature) temperature.push_back(0.0);
     material.push_back(mat);
     body.push_back(bod);
     state.resize(state.size() + static_cast<std::size_t>(n_state_per_particle), 0.0);

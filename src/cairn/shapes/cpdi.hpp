@@ -210,7 +210,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   // particle whose box does not fit sends the build through the sizing pass and a second try
   // (rare: the stride only grows).
   int slots = 1, widest = 1;
-  bool sized = !(cache.stride > 0 && cache.count.size() == particles.n());
+  bool sized = !(cache.layout == StencilLayout::list && cache.stride > 0 && cache.n == particles.n());
   if (!sized) {
     slots = cache.stride;
     widest = cache.stride;
@@ -250,14 +250,12 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     for (std::int64_t p = 0; p < n; ++p) {
       if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
         bad_t = std::min<std::int64_t>(bad_t, p);
-        cache.cell[p] = IVec<D>::Zero();
         cache.count[p] = 0;
         continue;
       }
       const Domain dom = cpdi_detail::make_domain<D, Fn>(grid, particles, p, max_span);
       IVec<D> cell;
       for (int a = 0; a < D; ++a) cell[a] = static_cast<int>(std::floor(dom.xi[a]));
-      cache.cell[p] = cell;
       // The common case takes the fixed (n_nodes + 1)^D box; stretched domains, the fallback and
       // a stride sized for smaller boxes take the general box of dom.dims.
       const bool fixed = !dom.fallback && dom.dims.maxCoeff() <= Fixed::width &&

@@ -57,7 +57,7 @@ class ShapeFamily {
   [[nodiscard]] virtual Vec<D> dof_position(const Grid<D>& grid, std::int32_t index) const {
     return grid.node_position(index);
   }
-  /// Fill cache.node/weight/gradient/count/cell and reach for every particle. Throws
+  /// Fill the cache's stencils (either layout) and reach for every particle. Throws
   /// SimulationFailure naming the lowest-index particle whose stencil leaves the stored grid.
   virtual void build(const Grid<D>& grid, const Particles<D>& particles,
                      TransferCache<D>& cache) const = 0;

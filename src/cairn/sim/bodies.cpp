@@ -229,7 +229,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
       particles.add(X, v0, particle_mass, particle_volume, lp, mat, static_cast<std::int32_t>(b));
       {
         const std::size_t p = particles.n() - 1;
-        particles.temperature[p] = materials[mat]->initial_temperature();
+        if (particles.has_temperature) particles.temperature[p] = materials[mat]->initial_temperature();
         if (particles.n_state_per_particle > 0)
           materials[mat]->initialize_state(&particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]);
       }

@@ -369,9 +369,8 @@ class Runner {
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
-    data.particles = sim_.particles();
     data.metadata = meta_;
-    write_checkpoint<D>(path, data);
+    write_checkpoint<D>(path, data, sim_.particles());  // no copy of the particles
     last_checkpoint_ = path;
   }
 

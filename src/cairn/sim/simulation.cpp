@@ -57,9 +57,15 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
+  particles_.has_affine = scheme_->affine();
+  particles_.has_temperature = config_.thermal.conduction;
+  for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
   check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
+  particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
+  material_in_use_.assign(materials_.size(), 0);
+  for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
   if (config_.thermal.conduction) {
     std::vector<double> k, cp;
     for (const auto& mc : config_.materials) {
@@ -83,14 +89,18 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     field_offset_.resize(particles_.n());
     for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
   }
-  nodes_.resize(n_slots());
-  grid_term_.assign(n_slots(), Vec<D>::Zero());
-  grid_proj_.assign(n_slots(), Vec<D>::Zero());
-  particle_vec_.assign(particles_.n(), Vec<D>::Zero());
-  particle_scalar_.assign(particles_.n(), 0.0);
-  body_acceleration_.assign(particles_.n(), Vec<D>::Zero());
+  // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
+  // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
+  const bool node_scratch = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
+  nodes_.resize(n_slots(), node_scratch);
+  if (node_scratch) {
+    grid_term_.assign(n_slots(), Vec<D>::Zero());
+    grid_proj_.assign(n_slots(), Vec<D>::Zero());
+  }
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
+  if (conditions_.empty() && velocity_conditions_.empty())
+    std::vector<Vec<D>>().swap(nodes_.reaction);  // nothing records reactions
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
   if (config_.method.integration == "wls") {
@@ -170,14 +180,24 @@ void Simulation<D>::setup_grid() {
 
 template <int D>
 double Simulation<D>::max_signal_speed() const {
+  // Materials whose wave speed does not depend on F are asked once (if they have particles);
+  // max |V| is sqrt(max |V|^2), the same number.
   const auto n = static_cast<std::int64_t>(particles_.n());
-  double c_max = 0.0, v_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v_max)
-  for (std::int64_t p = 0; p < n; ++p) {
-    c_max = std::max(c_max, materials_[particles_.material[p]]->wave_speed(particles_.deformation_gradient[p]));
-    v_max = std::max(v_max, particles_.velocity[p].norm());
+  const auto n_materials = static_cast<std::int32_t>(materials_.size());
+  double c_max = 0.0;
+  std::vector<char> varies(materials_.size(), 0);
+  for (std::int32_t m = 0; m < n_materials; ++m) {
+    varies[m] = materials_[m]->wave_speed_varies();
+    if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
   }
-  return c_max + v_max;
+  double v2_max = 0.0;
+#pragma omp parallel for reduction(max : c_max, v2_max)
+  for (std::int64_t p = 0; p < n; ++p) {
+    const std::int32_t m = particles_.material[p];
+    if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
+    v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
+  }
+  return c_max + std::sqrt(v2_max);
 }
 
 template <int D>
@@ -233,6 +253,10 @@ void Simulation<D>::step(double dt) {
       next_full_mass_time_ = time_ + config_.method.full_mass_cfl * grid_.min_cell_size() / max_signal_speed();
   }
   const bool fmpm_velocities = use_full_mass_ && need == FullMass::of_updated;
+  if (scheme_->affine() && particles_.affine_velocity.size() != particles_.n()) {
+    particles_.has_affine = true;  // e.g. restarted with APIC from a checkpoint without C_p
+    particles_.affine_velocity.assign(particles_.n(), Mat3::Zero());
+  }
   const int k = config_.method.order;
   step_dt_ = dt;
 
@@ -329,7 +353,8 @@ void Simulation<D>::wls_step(double dt) {
   std::string what;
 #pragma omp parallel for schedule(static)
   for (std::int64_t p = 0; p < n; ++p) {
-    const Mat3& L = particles_.velocity_gradient[p];
+    Mat3 L = Mat3::Zero();  // the integrator keeps grad V_p (Eq. 29 or the quadrature gradient)
+    L.template topLeftCorner<D, D>() = wls_->particle_velocity_gradient()[p];
     const Mat3 dF = Mat3::Identity() + L * dt;
     if (const char* bad = update_particle(static_cast<std::size_t>(p), L, dF, dt)) {
 #pragma omp critical(cairn_failure)
@@ -349,18 +374,15 @@ void Simulation<D>::wls_step(double dt) {
 template <int D>
 void Simulation<D>::build_stencils() {
   shape_->build(grid_, particles_, cache_);
-  colour_blocks(grid_, cache_);
-  if (contact_) contact_->fill_slots(particles_, cache_);
+  colour_blocks(grid_, particles_, cache_);
 }
 
 template <int D>
 void Simulation<D>::compute_body_forces() {
   if (body_force_.empty()) return;
   const auto n = static_cast<std::int64_t>(particles_.n());
-  if (body_force_constant_) {
-    std::fill(body_acceleration_.begin(), body_acceleration_.end(), body_force_value_);
-    return;
-  }
+  if (body_force_constant_) return;  // particles_to_grid reads body_force_value_
+  body_acceleration_.resize(particles_.n());
 #pragma omp parallel
   {
     auto& expr = *body_force_[omp_get_thread_num()];
@@ -388,7 +410,6 @@ template <int D>
 void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   const bool has_body_force = !body_force_.empty();
   const bool affine = scheme_->affine();
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) {
     if (mass_and_momentum) {
       nodes_.mass[i] = 0.0;
@@ -398,32 +419,47 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
       nodes_.force[i].setZero();
       if (has_body_force) node_body_force_[i].setZero();
     }
-    nodes_.reaction[i].setZero();
+    if (!nodes_.reaction.empty()) nodes_.reaction[i].setZero();
   });
   if (forces) compute_body_forces();
   const auto& P = particles_;
-  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    const std::int32_t i = idx[s];
-    const double Sm = cache_.weight[s] * P.mass[p];
-    if (mass_and_momentum) {
-      nodes_.mass[i] += Sm;
-      if (affine) {
-        const Vec<D> dx = node_offset(grid_, cache_.node[s], P.position[p]);
-        nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
-      } else {
-        nodes_.momentum[i] += Sm * P.velocity[p];
-      }
-    }
-    if (forces) {
-      nodes_.force[i] -= P.volume0[p] * (P.kirchhoff_stress[p].template topLeftCorner<D, D>() * cache_.gradient[s]);
-      if (has_body_force) {
-        const Vec<D> fb = Sm * body_acceleration_[p];
-        nodes_.force[i] += fb;
-        node_body_force_[i] += fb;
-      }
-    }
-  });
+  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1). The
+  // particle's factors (M, V, -V0 tau) are read once, not once per stencil entry, and the entry
+  // loop is compiled without tests for the plain step (all three sums, no affine part, no body
+  // force).
+  using MatD = Eigen::Matrix<double, D, D>;
+  auto extrapolate = [&](auto plain_tag) {
+    constexpr bool plain = decltype(plain_tag)::value;
+    scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      const double M = P.mass[p];
+      const Vec<D> V = P.velocity[p];
+      const MatD stress = -P.volume0[p] * P.kirchhoff_stress[p].template block<D>();
+      stencil.for_each_force(stress, [&](std::int32_t node, double S, const Vec<D>& force) {
+        const std::int32_t i = node + off;
+        const double Sm = S * M;
+        if (plain || mass_and_momentum) {
+          nodes_.mass[i] += Sm;
+          if (!plain && affine) {
+            const Vec<D> dx = node_offset(grid_, node, P.position[p]);
+            nodes_.momentum[i] += Sm * (V + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+          } else {
+            nodes_.momentum[i] += Sm * V;
+          }
+        }
+        if (plain || forces) {
+          nodes_.force[i] += force;
+          if (!plain && has_body_force) {
+            const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
+            nodes_.force[i] += fb;
+            node_body_force_[i] += fb;
+          }
+        }
+      });
+    });
+  };
+  if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
+  else extrapolate(std::false_type{});
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
     tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
@@ -494,7 +530,7 @@ void Simulation<D>::update_grid(double dt) {
   if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
     external_work_ += dt * chunked_sum<double>(n_slots(), 0.0, [&](std::int64_t i) {
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
-      double w = nodes_.reaction[i].dot(v_mean);
+      double w = nodes_.reaction.empty() ? 0.0 : nodes_.reaction[i].dot(v_mean);
       if (has_body_force) w += node_body_force_[i].dot(v_mean);
       return w;
     });
@@ -504,15 +540,21 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
-    Vec<D> u = Vec<D>::Zero();
-    for (std::size_t s = begin; s < end; ++s) u += cache_.weight[s] * in[idx[s]];
-    particle_vec_[p] = u;
+  particle_vec_.resize(particles_.n());
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    double u[D] = {};  // registers (see update_stresses)
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
+    });
+    particle_vec_[p] = Vec<D>(u);
   });
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    out[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particle_vec_[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      out[node + off] += (S * particles_.mass[p]) * particle_vec_[p];
+    });
   });
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
@@ -623,10 +665,12 @@ void Simulation<D>::stress_velocity_from_momentum(const std::vector<Vec<D>>& mom
 
 template <int D>
 void Simulation<D>::reextrapolate_momentum() {
-  const std::int32_t* idx = slots();
   for_each_node(n_slots(), [&](std::int32_t i) { grid_term_[i].setZero(); });
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
-    grid_term_[idx[s]] += (cache_.weight[s] * particles_.mass[p]) * particles_.velocity[p];
+  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      grid_term_[node + off] += (S * particles_.mass[p]) * particles_.velocity[p];
+    });
   });
   if (contact_)  // the re-extrapolated momenta obey contact too (same normals and separations)
     contact_->correct(nodes_.mass, grid_term_, true, Contact<D>::Pass::stress, time_, step_dt_, nullptr);
@@ -637,7 +681,6 @@ void Simulation<D>::update_particles(double dt) {
   // Task 4 in the unified form (seed 002 Eq. 1.7-1.12): V += A dt, X += VV dt + A dt^2 / 2.
   const UpdateScheme<D>& scheme =
       (scheme_->full_mass() != FullMass::none && !use_full_mass_) ? *flip_ : *scheme_;
-  const bool full = use_full_mass_;
   const bool updated_field = scheme_->full_mass() == FullMass::of_updated;
   const bool affine = scheme.affine();
   const double alpha_g = config_.method.grid_damping, alpha_p = config_.method.particle_damping;
@@ -645,53 +688,60 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  const std::int32_t* idx = slots();
   const bool contact_impulse = contact_ && contact_->impulse() && contact_->corrects_extrapolation();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
-    GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::int32_t i = idx[s];
-      const double S = cache_.weight[s];
-      g.Sv += S * v[i];
-      g.Sv_new += S * v_new[i];
-      if (full) g.Sv_full += S * v_full[i];
-    }
-    if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
-    if (contact_impulse) {
-      // The first correction's contact change is an impulse on the particle (docs/contact.md):
-      // V' = V + S dv_c, and the update proceeds from V'.
-      for (std::size_t s = begin; s < end; ++s) g.V += cache_.weight[s] * contact_impulse_[idx[s]];
-    }
-    Effective<D> e = scheme.effective(g);
-    e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
-    const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
-    // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
-    const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    particle_scalar_[p] = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
-    const Vec<D> x_old = P.position[p];
-    P.velocity[p] = g.V + e.A_dt;
-    P.position[p] += dX;
-    if (affine) {
-      // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
-      // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
-      // for every shape family (D = h^2/4 I for quadratic splines).
-      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
-      for (std::size_t s = begin; s < end; ++s) {
-        const Vec<D> d = node_offset(grid_, cache_.node[s], x_old);
-        B += cache_.weight[s] * v_new[idx[s]] * d.transpose();
-        Dp += cache_.weight[s] * d * d.transpose();
+  // The sum is the energy dissipated relative to the non-dissipative FLIP update (below). The
+  // entry loop is compiled with and without the full-mass velocity.
+  auto move = [&](auto full_tag) {
+    constexpr bool full = decltype(full_tag)::value;
+    return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+        const std::int32_t i = node + off;
+        for (int a = 0; a < D; ++a) {
+          sv[a] += S * v[i][a];
+          sv_new[a] += S * v_new[i][a];
+          if (full) sv_full[a] += S * v_full[i][a];
+        }
+      });
+      GridAtParticle<D> g{P.velocity[p], Vec<D>(sv), Vec<D>(sv_new), Vec<D>(sv_full), dt};
+      if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
+      if (contact_impulse) {
+        // The first correction's contact change is an impulse on the particle (docs/contact.md):
+        // V' = V + S dv_c, and the update proceeds from V'.
+        stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { g.V += S * contact_impulse_[node + off]; });
       }
-      P.affine_velocity[p].setZero();
-      P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
-    }
-  });
-  dissipated_energy_ += chunked_sum<double>(static_cast<std::int64_t>(P.n()), 0.0,
-                                            [&](std::int64_t p) { return particle_scalar_[p]; });
+      Effective<D> e = scheme.effective(g);
+      e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
+      const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+      // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+      // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
+      const Vec<D> ag_dt = g.Sv_new - g.Sv;
+      const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
+      const Vec<D> x_old = P.position[p];
+      P.velocity[p] = g.V + e.A_dt;  // g.V is V, or V' after a contact impulse
+      P.position[p] += dX;
+      if (affine) {
+        // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
+        // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
+        // for every shape family (D = h^2/4 I for quadratic splines).
+        Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+        stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+          const Vec<D> d = node_offset(grid_, node, x_old);
+          B += S * v_new[node + off] * d.transpose();
+          Dp += S * d * d.transpose();
+        });
+        P.affine_velocity[p].setZero();
+        P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
+      }
+      return dissipated;
+    });
+  };
+  dissipated_energy_ += use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
 }
 
 template <int D>
-Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
+void Simulation<D>::update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
   double* state = particles_.n_state_per_particle
                       ? &particles_.state[p * static_cast<std::size_t>(particles_.n_state_per_particle)]
@@ -700,10 +750,12 @@ Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, dou
   point.dF = &dF;
   point.tau_old = &particles_.kirchhoff_stress[p];
   point.cell_size = grid_.min_cell_size();
-  point.temperature = &particles_.temperature[p];
+  point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
+  point.planar = D < 3;
   const Material& m = *materials_[particles_.material[p]];
-  if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
-  return m.update(point);
+  SymMat3& tau = particles_.kirchhoff_stress[p];
+  if (mode_ == Mode::plane_stress) tau = plane_stress_update(m, F, point);
+  else m.update_stress(point, tau);
 }
 
 template <int D>
@@ -711,13 +763,32 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
-  const std::int32_t* idx = slots();
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
-    Mat3 L = Mat3::Zero();
-    for (std::size_t s = begin; s < end; ++s)
-      L.template topLeftCorner<D, D>() += grid_velocity[idx[s]] * cache_.gradient[s].transpose();
-    particles_.velocity_gradient[p] = L;
-    if (const char* bad = update_particle(static_cast<std::size_t>(p), L, tensor_exp(L * dt), dt)) {
+  // The kinematics stay in D dimensions: grad V has only its D x D block, so exp(grad V dt) is
+  // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change.
+  using MatD = Eigen::Matrix<double, D, D>;
+  gather(cache_, [&](std::int64_t p, const auto& stencil) {
+    const std::int32_t off = field_offset(p);
+    const MatD L_D = stencil.gradient_of(grid_velocity, off);
+    const MatD dF_D = tensor_exp<D>(L_D * dt);
+    Mat3& F = particles_.deformation_gradient[p];
+    F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+    Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
+    L.template topLeftCorner<D, D>() = L_D;
+    dF.template topLeftCorner<D, D>() = dF_D;
+    update_stress_of(static_cast<std::size_t>(p), L, dF, dt);
+    const SymMat3& tau = particles_.kirchhoff_stress[p];
+    const double J = F.determinant();
+    // One test for the common case: a sum is finite only if every term is.
+    const char* bad = nullptr;
+    if (!std::isfinite(particles_.velocity[p].sum() + particles_.position[p].sum() + tau.trace() +
+                       tau(1, 2) + tau(0, 2) + tau(0, 1)) ||
+        !(J > 0.0)) {
+      if (!particles_.velocity[p].allFinite()) bad = "velocity";
+      else if (!particles_.position[p].allFinite()) bad = "position";
+      else if (!(J > 0.0)) bad = "det F";
+      else if (!tau.allFinite()) bad = "stress";
+    }
+    if (bad) {
 #pragma omp critical(cairn_failure)
       if (first_bad < 0 || p < first_bad) {
         first_bad = p;
@@ -732,7 +803,7 @@ template <int D>
 const char* Simulation<D>::update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
   F = dF * F;
-  particles_.kirchhoff_stress[p] = stress_for(p, L, dF, dt);
+  update_stress_of(p, L, dF, dt);
   const double J = F.determinant();
   if (!particles_.velocity[p].allFinite()) return "velocity";
   if (!particles_.position[p].allFinite()) return "position";
@@ -766,7 +837,7 @@ NodeField<D> Simulation<D>::grid_totals() const {
       t.force[i] += nodes_.force[s];
       t.velocity_new[i] += nodes_.mass[s] * nodes_.velocity_new[s];
       t.velocity[i] += nodes_.mass[s] * nodes_.velocity[s];
-      t.reaction[i] += nodes_.reaction[s];
+      if (!nodes_.reaction.empty()) t.reaction[i] += nodes_.reaction[s];
     }
     if (t.mass[i] > small_mass_) {
       t.velocity_new[i] /= t.mass[i];
@@ -795,8 +866,9 @@ Totals Simulation<D>::totals() const {
     return Vec3(to3<D>(P.mass[p] * P.velocity[p]));
   });
   t.mass = chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p]; });
-  t.mean_temperature =
-      chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
+  if (P.has_temperature)
+    t.mean_temperature =
+        chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
   double p_max = -std::numeric_limits<double>::infinity();
 #pragma omp parallel for reduction(max : p_max)
   for (std::int64_t p = 0; p < n; ++p)

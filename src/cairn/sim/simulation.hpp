@@ -116,7 +116,8 @@ class Simulation {
  private:
   void setup_grid();
   void compute_body_forces();
-  Mat3 stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// The material's stress update of particle p into its stored stress (plane stress included).
+  void update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
   [[nodiscard]] double max_signal_speed() const;
   /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
   /// with conditions, or m~_k^-1 q for FMPM.
@@ -133,8 +134,8 @@ class Simulation {
   void subtract_contact_term(std::vector<Vec<D>>& out, int k);
   /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
   [[nodiscard]] std::int32_t n_slots() const { return grid_.n_nodes() * n_fields_; }
-  /// Per stencil entry, the index into the node arrays (cache.slot in multimaterial mode).
-  [[nodiscard]] const std::int32_t* slots() const { return contact_ ? cache_.slot.data() : cache_.node.data(); }
+  /// Offset of particle p's field in the node arrays (multimaterial mode; 0 otherwise).
+  [[nodiscard]] std::int32_t field_offset(std::int64_t p) const { return contact_ ? field_offset_[p] : 0; }
   /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
   /// with the values of the start or the end of the step.
   void impose_conditions(std::vector<Vec<D>>& velocity, typename VelocityConditions<D>::When when);
@@ -152,11 +153,11 @@ class Simulation {
   std::unique_ptr<UpdateScheme<D>> flip_;
   std::unique_ptr<Conduction<D>> conduction_;  ///< [thermal] conduction = true
   std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
+  std::vector<char> material_in_use_;     ///< whether any particle has material m
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
-  std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles
-  std::vector<double> particle_scalar_;    ///< scratch: per-particle dissipation of the step
+  std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)
   double dissipated_energy_ = 0.0;
   double step_dt_ = 0.0;
   double next_full_mass_time_ = 0.0;
@@ -164,7 +165,7 @@ class Simulation {
   std::vector<std::unique_ptr<ExpressionVector<D>>> body_force_;  ///< one per thread
   bool body_force_constant_ = false;
   Vec<D> body_force_value_ = Vec<D>::Zero();
-  std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step
+  std::vector<Vec<D>> body_acceleration_;  ///< b_p of this step (body forces that vary)
   GridConditions<D> conditions_;           ///< velocity conditions from [boundary]
   VelocityConditions<D> velocity_conditions_;  ///< [[velocity]] and [[wall]]
   Tractions<D> tractions_;                 ///< [[traction]]

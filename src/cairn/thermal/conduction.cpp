@@ -54,10 +54,12 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
     temperature_[i] = 0.0;
     heat_[i] = 0.0;
   });
-  scatter(cache, [&](std::int32_t p, std::size_t s) {
-    const double c = cache.weight[s] * P.mass[p] * cp_[P.material[p]];
-    capacity_[cache.node[s]] += c;
-    temperature_[cache.node[s]] += c * P.temperature[p];
+  scatter(cache, [&](std::int32_t p, const auto& stencil) {
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      const double c = S * P.mass[p] * cp_[P.material[p]];
+      capacity_[node] += c;
+      temperature_[node] += c * P.temperature[p];
+    });
   });
   for_each_node(n, [&](std::int32_t i) {
     temperature_[i] = capacity_[i] > 0.0 ? temperature_[i] / capacity_[i] : 0.0;
@@ -71,12 +73,14 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
   // Heat flow into the nodes from the particles' temperature gradients: V k grad T_p first,
   // then Q_i = -sum_p (V k grad T_p) . G_pi.
   if (flux_.size() != P.n()) flux_.assign(P.n(), Vec<D>::Zero());
-  gather(cache, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache, [&](std::int64_t p, const auto& stencil) {
     Vec<D> grad = Vec<D>::Zero();
-    for (std::size_t s = begin; s < end; ++s) grad += held_[cache.node[s]] * cache.gradient[s];
+    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) { grad += held_[node] * G; });
     flux_[p] = P.deformation_gradient[p].determinant() * P.volume0[p] * k_[P.material[p]] * grad;
   });
-  scatter(cache, [&](std::int32_t p, std::size_t s) { heat_[cache.node[s]] -= flux_[p].dot(cache.gradient[s]); });
+  scatter(cache, [&](std::int32_t p, const auto& stencil) {
+    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) { heat_[node] -= flux_[p].dot(G); });
+  });
   for (const auto& [i, f] : face_nodes_)
     if (config_.face[f] == ThermalFace::flux && capacity_[i] > 0.0) heat_[i] += config_.value[f] * face_area_[f];
   for_each_node(n, [&](std::int32_t i) {
@@ -84,10 +88,12 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
   });
   for (const auto& [i, f] : face_nodes_)
     if (config_.face[f] == ThermalFace::temperature) temperature_new_[i] = config_.value[f];
-  gather(cache, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  gather(cache, [&](std::int64_t p, const auto& stencil) {
     if (cp_[P.material[p]] <= 0.0) return;
     double dT = 0.0;
-    for (std::size_t s = begin; s < end; ++s) dT += cache.weight[s] * (temperature_new_[cache.node[s]] - temperature_[cache.node[s]]);
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      dT += S * (temperature_new_[node] - temperature_[node]);
+    });
     P.temperature[p] += dT;
   });
 }

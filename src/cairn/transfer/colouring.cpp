@@ -5,7 +5,7 @@
 namespace cairn {
 
 template <int D>
-void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
+void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferCache<D>& cache) {
   // Blocks along each axis must be wider than reach_lo + reach_hi cells so that blocks two apart
   // (same colour) touch disjoint nodes. Cells are split evenly, so every block has at least the
   // minimum width even when the block count does not divide the cell count.
@@ -24,7 +24,7 @@ void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
   }
   const int total_blocks = n_blocks.prod();
   const int total_colours = n_colours.prod();
-  const auto n = static_cast<std::int64_t>(cache.count.size());
+  const auto n = static_cast<std::int64_t>(cache.n);
 
   auto block_along = [&](int a, int c) {
     const int nc = grid.n_cells()[a];
@@ -38,9 +38,10 @@ void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
 
 #pragma omp parallel for schedule(static)
   for (std::int64_t p = 0; p < n; ++p) {
+    const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
     int id = 0, mult = 1;
     for (int a = 0; a < D; ++a) {
-      id += block_along(a, cache.cell[p][a]) * mult;
+      id += block_along(a, cell[a]) * mult;
       mult *= n_blocks[a];
     }
     cache.block_of[p] = id;
@@ -72,8 +73,8 @@ void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache) {
   }
 }
 
-template void colour_blocks<1>(const Grid<1>&, TransferCache<1>&);
-template void colour_blocks<2>(const Grid<2>&, TransferCache<2>&);
-template void colour_blocks<3>(const Grid<3>&, TransferCache<3>&);
+template void colour_blocks<1>(const Grid<1>&, const Particles<1>&, TransferCache<1>&);
+template void colour_blocks<2>(const Grid<2>&, const Particles<2>&, TransferCache<2>&);
+template void colour_blocks<3>(const Grid<3>&, const Particles<3>&, TransferCache<3>&);
 
 }  // namespace cairn

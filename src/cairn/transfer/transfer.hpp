@@ -1,5 +1,11 @@
 // Generic particle<->grid kernels over the transfer cache, written once for every shape family.
 //
+// A kernel's callback gets a particle index and that particle's stencil, whose for_each(fn)
+// calls fn(node, S, G) for every entry: node is the storage index (add the particle's field
+// offset in multimaterial mode), S = S_pi and G = G_pi. The stencil type depends on the cache
+// layout (transfer/cache.hpp), so callbacks are generic lambdas ([&](auto p, const auto& st));
+// each kernel picks the layout once per call and the entry loop is compiled for it.
+//
 // Parallel strategy and the guarantee it gives: particles are binned into blocks of cells wide
 // enough that two blocks of the same colour never touch a common node. Scatters run colour by
 // colour; within a colour, blocks run in parallel and each block adds its particles in storage
@@ -7,45 +13,284 @@
 // the number of threads, so results are bit-identical for any OMP_NUM_THREADS.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 
 namespace cairn {
 
-/// Bin particles into coloured cell blocks using cache.cell and the reach reported by the shape
-/// family. Call after every stencil build. Allocation-free once sized.
+/// Bin particles into coloured cell blocks by the cell holding each particle (grid.cell_of) and
+/// the reach reported by the shape family. Call after every stencil build. Allocation-free once
+/// sized.
 template <int D>
-void colour_blocks(const Grid<D>& grid, TransferCache<D>& cache);
+void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferCache<D>& cache);
 
-/// Scatter: calls fn(p, slot) for every particle p and stencil slot, race-free as above; fn may
-/// add into node arrays indexed by cache.node[slot].
-template <int D, class Fn>
-void scatter(const TransferCache<D>& cache, Fn&& fn) {
-  for (const auto& blocks : cache.colour_blocks) {
-    const auto n_blocks = static_cast<std::int64_t>(blocks.size());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t b = 0; b < n_blocks; ++b) {
-      const std::int32_t block = blocks[b];
-      for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
-        const std::int32_t p = cache.order[i];
-        const std::size_t base = static_cast<std::size_t>(p) * cache.stride;
-        for (std::size_t s = base; s < base + cache.count[p]; ++s) fn(p, s);
+/// One particle's stencil in the list layout.
+template <int D>
+struct ListStencil {
+  const std::int32_t* node;
+  const double* weight;
+  const Vec<D>* gradient;
+  int count;
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    for (int s = 0; s < count; ++s) fn(node[s], weight[s], gradient[s]);
+  }
+  /// fn(node, S, stress G) for every entry (the internal-force term of P2G).
+  template <class Fn>
+  void for_each_force(const Eigen::Matrix<double, D, D>& stress, Fn&& fn) const {
+    for (int s = 0; s < count; ++s) fn(node[s], weight[s], Vec<D>(stress * gradient[s]));
+  }
+  /// sum over entries of u_i (x) G_i, u_i = u[node + offset] (the velocity gradient of Task 5).
+  [[nodiscard]] Eigen::Matrix<double, D, D> gradient_of(const std::vector<Vec<D>>& u, std::int32_t offset) const {
+    double l[D][D] = {};  // plain doubles stay in registers (docs/performance.md, "sums")
+    for (int s = 0; s < count; ++s) {
+      const Vec<D>& v = u[node[s] + offset];
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) l[a][b] += v[a] * gradient[s][b];
+    }
+    Eigen::Matrix<double, D, D> out;
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) out(a, b) = l[a][b];
+    return out;
+  }
+};
+
+/// One particle's stencil in the tensor layout with W nodes per axis: entry (k_0, ..., k_D-1),
+/// axis 0 fastest, has node sum_a offset_a(k_a), S = prod_a phi_a(k_a) and
+/// G_b = prod_a (a == b ? dphi_a : phi_a)(k_a) (seed 003 Eq. 18), the products taken in axis order.
+template <int D, int W>
+struct TensorStencil {
+  const std::int32_t* node;  ///< D x W offsets
+  const double* value;       ///< D x 2W: phi then dphi per axis
+
+  template <class Fn>
+  void for_each(Fn&& fn) const {
+    const double* w0 = value;
+    const double* d0 = value + W;
+    if constexpr (D == 1) {
+      for (int i = 0; i < W; ++i) fn(node[i], w0[i], Vec<1>(d0[i]));
+    } else {
+      const double* w1 = value + 2 * W;
+      const double* d1 = value + 3 * W;
+      if constexpr (D == 2) {
+        for (int j = 0; j < W; ++j)
+          for (int i = 0; i < W; ++i) fn(node[i] + node[W + j], w0[i] * w1[j], Vec<2>(d0[i] * w1[j], w0[i] * d1[j]));
+      } else {
+        const double* w2 = value + 4 * W;
+        const double* d2 = value + 5 * W;
+        for (int k = 0; k < W; ++k)
+          for (int j = 0; j < W; ++j) {
+            const std::int32_t row = node[W + j] + node[2 * W + k];
+            for (int i = 0; i < W; ++i) {
+              const double w01 = w0[i] * w1[j];
+              fn(row + node[i], w01 * w2[k],
+                 Vec<3>((d0[i] * w1[j]) * w2[k], (w0[i] * d1[j]) * w2[k], w01 * d2[k]));
+            }
+          }
       }
     }
   }
+  /// As ListStencil::for_each_force and gradient_of, by sum factorisation (tensor_force below).
+  template <class Fn>
+  void for_each_force(const Eigen::Matrix<double, D, D>& stress, Fn&& fn) const;
+  [[nodiscard]] Eigen::Matrix<double, D, D> gradient_of(const std::vector<Vec<D>>& u, std::int32_t offset) const;
+};
+
+/// The same operations on the tensor layout by sum factorisation: G_i is never formed. The
+/// force stress G_ijk = w2_k (w1_j A_i + dw1_j B_i) + dw2_k w1_j C_i with A_i = dw0_i s_0,
+/// B_i = w0_i s_1, C_i = w0_i s_2 (s_b the stress columns), and the gradient
+/// sum_ijk u_ijk (x) G_ijk takes the sums over i first: a_jk = sum_i dw0_i u_ijk and
+/// b_jk = sum_i w0_i u_ijk, then L = sum_jk [w1_j w2_k a_jk, dw1_j w2_k b_jk, w1_j dw2_k b_jk].
+/// For a 3D quadratic B-spline that is 6 instead of 15 multiply-adds per entry.
+template <int D, int W>
+void tensor_force(const TensorStencil<D, W>& st, const Eigen::Matrix<double, D, D>& stress, auto&& fn) {
+  if constexpr (D != 3) {
+    st.for_each([&](std::int32_t node, double S, const Vec<D>& G) { fn(node, S, Vec<D>(stress * G)); });
+  } else {
+    const std::int32_t* n = st.node;
+    const double *w0 = st.value, *d0 = w0 + W, *w1 = w0 + 2 * W, *d1 = w0 + 3 * W, *w2 = w0 + 4 * W,
+                 *d2 = w0 + 5 * W;
+    double A[W][3], B[W][3], C[W][3];
+    for (int i = 0; i < W; ++i)
+      for (int r = 0; r < 3; ++r) {
+        A[i][r] = d0[i] * stress(r, 0);
+        B[i][r] = w0[i] * stress(r, 1);
+        C[i][r] = w0[i] * stress(r, 2);
+      }
+    for (int k = 0; k < W; ++k)
+      for (int j = 0; j < W; ++j) {
+        const std::int32_t row = n[W + j] + n[2 * W + k];
+        const double wjk = w1[j] * w2[k], djk = d1[j] * w2[k], ejk = w1[j] * d2[k];
+        for (int i = 0; i < W; ++i) {
+          const Vec<3> f(wjk * A[i][0] + djk * B[i][0] + ejk * C[i][0],
+                         wjk * A[i][1] + djk * B[i][1] + ejk * C[i][1],
+                         wjk * A[i][2] + djk * B[i][2] + ejk * C[i][2]);
+          fn(row + n[i], w0[i] * wjk, f);
+        }
+      }
+  }
 }
 
-/// Gather: calls fn(p, begin, end) for every particle in parallel with its slot range.
+template <int D, int W>
+Eigen::Matrix<double, D, D> tensor_gradient_of(const TensorStencil<D, W>& st, const std::vector<Vec<D>>& u,
+                                               std::int32_t offset) {
+  double l[D][D] = {};  // plain doubles stay in registers (docs/performance.md, "sums")
+  if constexpr (D != 3) {
+    st.for_each([&](std::int32_t node, double, const Vec<D>& G) {
+      const Vec<D>& v = u[node + offset];
+      for (int a = 0; a < D; ++a)
+        for (int b = 0; b < D; ++b) l[a][b] += v[a] * G[b];
+    });
+  } else {
+    const std::int32_t* n = st.node;
+    const double *w0 = st.value, *d0 = w0 + W, *w1 = w0 + 2 * W, *d1 = w0 + 3 * W, *w2 = w0 + 4 * W,
+                 *d2 = w0 + 5 * W;
+    for (int k = 0; k < W; ++k)
+      for (int j = 0; j < W; ++j) {
+        const std::int32_t row = n[W + j] + n[2 * W + k] + offset;
+        double a[3] = {}, b[3] = {};
+        for (int i = 0; i < W; ++i) {
+          const Vec<3>& v = u[row + n[i]];
+          for (int r = 0; r < 3; ++r) {
+            a[r] += d0[i] * v[r];
+            b[r] += w0[i] * v[r];
+          }
+        }
+        const double wjk = w1[j] * w2[k], djk = d1[j] * w2[k], ejk = w1[j] * d2[k];
+        for (int r = 0; r < 3; ++r) {
+          l[r][0] += wjk * a[r];
+          l[r][1] += djk * b[r];
+          l[r][2] += ejk * b[r];
+        }
+      }
+  }
+  Eigen::Matrix<double, D, D> out;
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) out(a, b) = l[a][b];
+  return out;
+}
+
+template <int D, int W>
+template <class Fn>
+void TensorStencil<D, W>::for_each_force(const Eigen::Matrix<double, D, D>& stress, Fn&& fn) const {
+  tensor_force(*this, stress, fn);
+}
+template <int D, int W>
+Eigen::Matrix<double, D, D> TensorStencil<D, W>::gradient_of(const std::vector<Vec<D>>& u, std::int32_t offset) const {
+  return tensor_gradient_of(*this, u, offset);
+}
+
+/// Calls fn(stencil_of) with a callable that returns particle p's stencil, typed for the cache's
+/// layout (and width), so that everything fn does per particle is compiled for that layout.
+template <int D, class Fn>
+void with_stencils(const TransferCache<D>& cache, Fn&& fn) {
+  if (cache.layout == StencilLayout::list) {
+    fn([&cache](std::size_t p) {
+      const std::size_t b = p * static_cast<std::size_t>(cache.stride);
+      return ListStencil<D>{&cache.node[b], &cache.weight[b], &cache.gradient[b], cache.count[p]};
+    });
+    return;
+  }
+  auto tensor = [&]<int W>() {
+    fn([&cache](std::size_t p) {
+      return TensorStencil<D, W>{&cache.axis_node[p * D * W], &cache.axis_value[p * D * 2 * W]};
+    });
+  };
+  switch (cache.width) {
+    case 2: tensor.template operator()<2>(); break;
+    case 3: tensor.template operator()<3>(); break;
+    default: tensor.template operator()<4>(); break;
+  }
+}
+
+/// fn(node, S, G) for every stencil entry of particle p (one layout test per call: for code
+/// outside the hot loops).
+template <int D, class Fn>
+void for_each_entry(const TransferCache<D>& cache, std::size_t p, Fn&& fn) {
+  with_stencils(cache, [&](auto stencil_of) { stencil_of(p).for_each(fn); });
+}
+
+/// One stencil entry, for code that wants the entries as data (tests, diagnostics).
+template <int D>
+struct StencilEntry {
+  std::int32_t node;
+  double weight;
+  Vec<D> gradient;
+};
+
+/// Particle p's entries with S != 0 or G != 0, in stencil order.
+template <int D>
+std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std::size_t p) {
+  std::vector<StencilEntry<D>> out;
+  for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>& G) {
+    if (S != 0.0 || !G.isZero(0.0)) out.push_back({node, S, G});
+  });
+  return out;
+}
+
+/// Scatter: calls fn(p, stencil) for every particle p, race-free as above; fn may add into node
+/// arrays at the stencil's nodes.
+template <int D, class Fn>
+void scatter(const TransferCache<D>& cache, Fn&& fn) {
+  with_stencils(cache, [&](auto stencil_of) {
+    for (const auto& blocks : cache.colour_blocks) {
+      const auto n_blocks = static_cast<std::int64_t>(blocks.size());
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::int64_t b = 0; b < n_blocks; ++b) {
+        const std::int32_t block = blocks[b];
+        for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
+          const std::int32_t p = cache.order[i];
+          fn(p, stencil_of(static_cast<std::size_t>(p)));
+        }
+      }
+    }
+  });
+}
+
+/// Particles per work chunk of a gather. Fixed, so that sums taken chunk by chunk do not depend
+/// on the thread count; small, so that threads share the work evenly when one of them is slowed
+/// down by another process on its core (chunks are handed out dynamically).
+inline constexpr std::int64_t gather_chunk = 512;
+
+/// Gather: calls fn(p, stencil) for every particle, in parallel over chunks of particles.
 template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
-  const auto n = static_cast<std::int64_t>(cache.count.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const std::size_t base = static_cast<std::size_t>(p) * cache.stride;
-    fn(p, base, base + cache.count[p]);
-  }
+  with_stencils(cache, [&](auto stencil_of) {
+    const auto n = static_cast<std::int64_t>(cache.n);
+    const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
+    }
+  });
+}
+
+/// Gather that also returns sum_p fn(p, stencil): a running sum within each chunk, the chunks'
+/// sums added in chunk order, so the total is the same for any thread count.
+template <int D, class Fn>
+double gather_sum(const TransferCache<D>& cache, Fn&& fn) {
+  const auto n = static_cast<std::int64_t>(cache.n);
+  const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+  std::vector<double> partial(static_cast<std::size_t>(n_chunks), 0.0);
+  with_stencils(cache, [&](auto stencil_of) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t c = 0; c < n_chunks; ++c) {
+      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+      double sum = 0.0;
+      for (std::int64_t p = c * gather_chunk; p < end; ++p) sum += fn(p, stencil_of(static_cast<std::size_t>(p)));
+      partial[static_cast<std::size_t>(c)] = sum;
+    }
+  });
+  double total = 0.0;
+  for (double s : partial) total += s;
+  return total;
 }
 
 /// Parallel loop over nodes.

@@ -109,7 +109,6 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
           outside |= off[a][k] < 0;
         }
       }
-      cache_.cell[p] = cell;
       cache_.count[p] = static_cast<std::uint16_t>(slots);
       if (outside) {
         bad_t = std::min(bad_t, p);
@@ -152,7 +151,7 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
   }
   cache_.reach_lo = IVec<D>::Ones();
   cache_.reach_hi = IVec<D>::Ones();
-  colour_blocks(grid, cache_);
+  colour_blocks(grid, particles, cache_);  // blocks by the cell holding each particle
 }
 
 template <int D>
@@ -188,7 +187,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   });
   // Moment matrices and load vectors (Eq. 9) with the wide weight; particle flags (Eq. 13) and
   // surface positions (Eq. 15) with the narrow shape.
-  scatter(cache_, [&](std::int32_t p, std::size_t s) {
+  auto entry = [&](std::int32_t p, std::size_t s) {
     const std::int32_t i = cache_.node[s];
     const double S = shape_[s];
     if (S != 0.0) {
@@ -213,6 +212,13 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     }
     max_weight_[i] = std::max(max_weight_[i], W);
     ++count_[i];
+  };
+  // The list-layout cache holds all 3^D slots of every particle; shape_ and offset_ share its
+  // slot numbering.
+  constexpr int slots = pow3(D);
+  scatter(cache_, [&](std::int32_t p, const auto&) {
+    const std::size_t base = static_cast<std::size_t>(p) * slots;
+    for (std::size_t s = base; s < base + slots; ++s) entry(p, s);
   });
   fit_nodes(grid, n_used);
   refine_distance(grid);
@@ -454,7 +460,7 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     internal_force_[i] = fi;
     nodes.force[i] = fe;
     if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
-    nodes.reaction[i].setZero();
+    if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
   });
   // Sec. 3.5 / 4.5: the internal force of a spurious node is the mean over its 3^D - 1
   // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
@@ -582,7 +588,10 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const auto& v_new = nodes.velocity_new;
   const bool from_quadrature = options_.quadrature_gradient;
   if (from_quadrature) quadrature_gradients(grid, v_new);
-  gather(cache_, [&](std::int64_t p, std::size_t begin, std::size_t end) {
+  constexpr int slots = pow3(D);
+  particle_gradient_.resize(particles.n());
+  gather(cache_, [&](std::int64_t p, const auto&) {
+    const std::size_t begin = static_cast<std::size_t>(p) * slots, end = begin + slots;
     Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
     double weight = 0.0;
@@ -603,8 +612,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     if (from_quadrature && weight > 0.0) L /= weight;
     particles.velocity[p] += dv;
     particles.position[p] += vx * dt;
-    particles.velocity_gradient[p].setZero();
-    particles.velocity_gradient[p].template topLeftCorner<D, D>() = L;
+    particle_gradient_[p] = L;
   });
 }
 
@@ -616,7 +624,9 @@ Particles<D> region_points(const Integrator<D>& integrator) {
     const Region<D>& q = regions[r];
     const int within = (r > 0 && regions[r - 1].cell == q.cell) ? out.material.back() + 1 : 0;
     out.add(q.centroid, Vec<D>::Zero(), q.density * q.volume, q.volume, Vec<D>::Zero(), within, q.cell);
-    out.kirchhoff_stress.back().template topLeftCorner<D, D>() = q.stress;
+    Mat3 tau = Mat3::Zero();
+    tau.template topLeftCorner<D, D>() = q.stress;
+    out.kirchhoff_stress.back() = tau;
   }
   return out;
 }

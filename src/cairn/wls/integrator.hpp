@@ -84,7 +84,7 @@ class Integrator {
                std::vector<Vec<D>>* node_body_force);
 
   /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
-  /// x += S v+ dt, and the velocity gradient into particles.velocity_gradient: Eq. 29
+  /// x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
   /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
   /// integration points' gradients.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);
@@ -108,6 +108,10 @@ class Integrator {
   [[nodiscard]] const std::vector<double>& node_flags() const { return beta_; }
   /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced.
   [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
+  /// grad V_p of every particle from the last move_particles (the F and stress update's L).
+  [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
+    return particle_gradient_;
+  }
 
  private:
   static constexpr int n_basis = D + 1;
@@ -155,6 +159,7 @@ class Integrator {
   std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
+  std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)
   std::vector<Vec<D>> filtered_;                              ///< scratch of filter_acceleration
 };
 
