@@ -75,7 +75,7 @@ TEST(MieGruneisen, EnergyOnTheHugoniotGivesTheReferenceHugoniot) {
     m->initialize_state(st.data());
     st[0] = U;
     Mat3 F = Mat3::Identity() * std::cbrt(1.0 - eta);  // isotropic: no shear stress
-    const Mat3 L = Mat3::Zero(), zero = Mat3::Zero(), dF = Mat3::Identity();
+    const Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
     MaterialPoint pt{F, L, st.data(), 0.0};
     pt.dF = &dF;
     const SymMat3 zero_stress;
