@@ -83,9 +83,11 @@ void check_plane_fit(unsigned seed) {
 }
 
 TEST(WlsLeastSquares, PlanarBasisReproducesLinearFieldsExactly) {
+  // The checks are in the helper; ASSERT_NO_FATAL_FAILURE stops at the first seed whose fit fails.
   for (unsigned s = 1; s <= 20; ++s) {
-    check_plane_fit<2>(s);
-    check_plane_fit<3>(100 + s);
+    SCOPED_TRACE(s);
+    ASSERT_NO_FATAL_FAILURE(check_plane_fit<2>(s));
+    ASSERT_NO_FATAL_FAILURE(check_plane_fit<3>(100 + s));
   }
 }
 
@@ -163,9 +165,9 @@ void check_planar_cuts(unsigned seed, int trials) {
   EXPECT_GT(checked, trials / 2);
 }
 
-TEST(WlsCutCell, PlanarCutsGiveExactAreasAndCentroidsIn2D) { check_planar_cuts<2>(7, 400); }
+TEST(WlsCutCell, PlanarCutsGiveExactAreasAndCentroidsIn2D) { ASSERT_NO_FATAL_FAILURE(check_planar_cuts<2>(7, 400)); }
 
-TEST(WlsCutCell, PlanarCutsGiveExactVolumesAndCentroidsIn3D) { check_planar_cuts<3>(11, 400); }
+TEST(WlsCutCell, PlanarCutsGiveExactVolumesAndCentroidsIn3D) { ASSERT_NO_FATAL_FAILURE(check_planar_cuts<3>(11, 400)); }
 
 TEST(WlsCutCell, AxisAlignedCutsAndScaledCells) {
   // Cell [1, 3] x [2, 2.5] cut at x = 1.5 (d = 1.5 - x): the left quarter.
@@ -489,9 +491,9 @@ void check_linear_velocity(const std::string& kind) {
 }
 
 TEST(WlsIntegration, NodeFitsReproduceLinearVelocityFields) {
-  check_linear_velocity<2>("circle");
-  check_linear_velocity<2>("box");
-  check_linear_velocity<3>("sphere");
+  ASSERT_NO_FATAL_FAILURE(check_linear_velocity<2>("circle"));
+  ASSERT_NO_FATAL_FAILURE(check_linear_velocity<2>("box"));
+  ASSERT_NO_FATAL_FAILURE(check_linear_velocity<3>("sphere"));
 }
 
 template <int D>
@@ -522,9 +524,9 @@ void check_particle_gradient(const std::string& velocity_gradient) {
 }
 
 TEST(WlsIntegration, ParticleVelocityGradientsReproduceLinearFields) {
-  check_particle_gradient<2>("quadrature");
-  check_particle_gradient<2>("narrow");
-  check_particle_gradient<3>("quadrature");
+  ASSERT_NO_FATAL_FAILURE(check_particle_gradient<2>("quadrature"));
+  ASSERT_NO_FATAL_FAILURE(check_particle_gradient<2>("narrow"));
+  ASSERT_NO_FATAL_FAILURE(check_particle_gradient<3>("quadrature"));
 }
 
 TEST(WlsIntegration, RigidTranslationStaysUndeformed) {
