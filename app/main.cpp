@@ -8,7 +8,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
+#include <unistd.h>
 
+#include <cstdlib>
 #include <iostream>
 #include <new>
 #include <sstream>
@@ -102,6 +104,15 @@ constexpr int max_threads = 1024;
 }  // namespace
 
 int main(int argc, char** argv) {
+  // OpenMP threads that wait at a barrier sleep instead of spinning, unless the user chose a
+  // policy: spinning makes 2 threads many times slower than 1 when another process is busy on
+  // the machine (docs/performance.md, "Threads on a shared machine"). libgomp reads the policy
+  // when it loads, before main, so the process restarts itself once with it set (same pid),
+  // before MPI is initialised.
+  if (std::getenv("OMP_WAIT_POLICY") == nullptr && std::getenv("GOMP_SPINCOUNT") == nullptr) {
+    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    ::execv("/proc/self/exe", argv);  // returns only on failure: go on with the runtime's default
+  }
   // Under mpirun/srun every rank runs this program (docs/parallel.md); rank 0 alone prints.
   // Every rank reads and validates the input itself, so an input error stops them all with the
   // same exit code; a simulation failure is detected collectively (exit 3 everywhere).
@@ -166,7 +177,11 @@ int main(int argc, char** argv) {
   // Only rank 0 talks; the others' standard output and error stay quiet.
   std::ostringstream discard;
   std::ostream& err = root ? std::cerr : discard;
-  if (threads > 0) omp_set_num_threads(threads);
+  if (threads > 0) {
+    omp_set_num_threads(threads);
+    // The command line wins over the input file's simulation.threads (docs/robustness.md).
+    overrides.push_back(fmt::format("simulation.threads={}", threads));
+  }
 
   try {
     if (*keys) {

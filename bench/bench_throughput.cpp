@@ -8,6 +8,7 @@
 #include <omp.h>
 
 #include "cairn/sim/simulation.hpp"
+#include "run_steps.hpp"
 
 namespace cairn {
 namespace {
@@ -43,22 +44,7 @@ Config bench_config(const std::string& shape, const std::string& model, int cell
   return c;
 }
 
-template <int D>
-void run_steps(benchmark::State& state, const Config& cfg) {
-  const int threads = static_cast<int>(state.range(0));
-  omp_set_num_threads(threads);
-  Simulation<D> sim(cfg);
-  const double dt = sim.next_dt();
-  for (int i = 0; i < 3; ++i) sim.step(dt);  // warm up: first stencil build sizes the cache
-  for (auto _ : state) sim.step(dt);
-  const double n = static_cast<double>(sim.particles().n());
-  state.counters["particles"] = n;
-  state.counters["threads"] = threads;
-  state.counters["particle_steps_per_s"] =
-      benchmark::Counter(n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["particle_steps_per_s_per_core"] = benchmark::Counter(
-      n * static_cast<double>(state.iterations()) / threads, benchmark::Counter::kIsRate);
-}
+using bench::run_steps;
 
 void BM_Step2D_BSpline2_NeoHookean(benchmark::State& state) {
   run_steps<2>(state, bench_config<2>("bspline2", "neo_hookean", 160, 2));  // 36864 particles

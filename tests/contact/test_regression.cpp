@@ -609,5 +609,124 @@ TEST(RegressionDeformedRadius, OnlyTheFirstDimComponentsOfN0Enter) {
   EXPECT_NEAR(deformed_radius(F, r0, Vec3::UnitX(), 3), r3, 1e-15);
 }
 
+
+// ---- Flat interfaces through particle lattices (docs/contact.md, "Flat interfaces") ----------
+
+/// A floor (class -1, y < 0) and a block (class +1, y > 0) filled with 2-per-cell lattices
+/// (spacing 0.5 cells), the block's lattice shifted by `s` cells along the interface and its rear
+/// face at x = `rear` (-inf: no face). The cloud of the node at (xn, 0) holds the particles within
+/// `support` cells of it along both axes (the particles whose stencil holds the node); w holds
+/// the node's linear hat at each particle (a shape-function weight S_ip).
+struct FlatCloud : Cloud {
+  std::vector<double> w;
+};
+FlatCloud flat_cloud(double s, double xn, double rear, double support) {
+  FlatCloud c;
+  auto add = [&](const Vec3& p, int cls) {
+    const Vec3 d = p - Vec3(xn, 0.0, 0.0);
+    if (std::abs(d.x()) >= support || std::abs(d.y()) >= support) return;
+    c.add(p, cls);
+    c.w.push_back(std::max(0.0, 1.0 - std::abs(d.x())) * std::max(0.0, 1.0 - std::abs(d.y())));
+  };
+  for (int i = -20; i < 20; ++i)
+    for (int j = 0; j < 4; ++j) {
+      add(Vec3(0.25 + 0.5 * i, -0.25 - 0.5 * j, 0.0), -1);
+      const Vec3 b(s + 0.25 + 0.5 * i, 0.25 + 0.5 * j, 0.0);
+      if (b.x() > rear) add(b, +1);
+    }
+  return c;
+}
+
+double tilt(const Vec3& n) { return std::atan2(n.x(), n.y()); }
+
+TEST(RegressionFlatInterface, UniformLogisticFitTiltsWithTheLatticeOffset) {
+  // The finite-scale logistic fit with w_p = 1 turns the normal toward the class whose points
+  // stand off-centre along the interface: a tilt of milliradians that changes sign with the
+  // offset, also when converged far beyond the Eq. 57 tolerance.
+  PlaneFitOptions opt, tight;
+  opt.dim = tight.dim = 2;
+  tight.tolerance = 1e-15;
+  tight.max_iterations = 200;
+  double worst = 0.0, worst_tight = 0.0;
+  for (int k = 1; k < 10; ++k) {
+    const FlatCloud c = flat_cloud(0.05 * k, 0.0, -1e9, 1.5);
+    worst = std::max(worst, std::abs(tilt(fit(c, Vec3::Zero(), opt, PlaneFitMethod::logistic).normal)));
+    worst_tight = std::max(worst_tight, std::abs(tilt(fit(c, Vec3::Zero(), tight, PlaneFitMethod::logistic).normal)));
+  }
+  EXPECT_GT(worst, 3e-3);
+  EXPECT_GT(worst_tight, 1e-3);
+}
+
+TEST(RegressionFlatInterface, ShapeWeightsMakeTheInteriorNormalExact) {
+  // With w_p = N_i(X_p), a B-spline of the grid whose width is a multiple of the particle
+  // spacing, every row of a class has its weighted centroid on the node: the fit's tangential
+  // gradient vanishes at a level normal, for any lattice offset.
+  PlaneFitOptions opt;
+  opt.dim = 2;
+  for (auto m : {PlaneFitMethod::linear, PlaneFitMethod::logistic})
+    for (int k = 0; k < 10; ++k) {
+      const FlatCloud c = flat_cloud(0.05 * k, 0.0, -1e9, 1.25);
+      const PlaneFit f = fit_separating_plane(c.x, c.cls, c.w, Vec3::Zero(), opt, m);
+      ASSERT_TRUE(f.ok);
+      EXPECT_LT(std::abs(tilt(f.normal)), 1e-12) << "offset " << 0.05 * k;
+    }
+}
+
+TEST(RegressionFlatInterface, MaxMarginIsExactInsideAndAtACorner) {
+  for (double rear : {-1e9, 0.0, -0.5, -1.0})
+    for (int k = 0; k < 10; ++k) {
+      const FlatCloud c = flat_cloud(0.05 * k, 0.0, rear, 1.5);
+      const MarginFit m = max_margin_plane(c.x, c.cls, 2);
+      ASSERT_TRUE(m.ok);
+      EXPECT_LT(std::abs(tilt(m.normal)), 1e-12) << "rear " << rear << " offset " << 0.05 * k;
+      EXPECT_NEAR(m.gap, 0.5, 1e-12);
+    }
+  // At the block's rear corner the logistic fit (either weighting) tilts by tens of mrad.
+  const FlatCloud c = flat_cloud(0.1, 0.0, 0.0, 1.5);
+  PlaneFitOptions opt;
+  opt.dim = 2;
+  EXPECT_GT(std::abs(tilt(fit(c, Vec3::Zero(), opt, PlaneFitMethod::logistic).normal)), 1e-2);
+}
+
+TEST(RegressionMaxMargin, TiltedPlanesAndThreeDimensions) {
+  const double th = 30.0 * kPi / 180.0;
+  const Vec3 n2(std::sin(th), std::cos(th), 0.0);
+  const Cloud c2 = tilted_cloud(2, 1.5, Vec3(3.0, -1.5, 0.0), n2);
+  const MarginFit m2 = max_margin_plane(c2.x, c2.cls, 2);
+  ASSERT_TRUE(m2.ok);
+  EXPECT_LT(angle_between(m2.normal, n2), 1e-12);
+  EXPECT_NEAR(m2.gap, 2.0 * 0.25 * 1.5, 1e-12);
+  const Vec3 n3 = Vec3(0.3, -0.5, 0.8).normalized();
+  const Cloud c3 = tilted_cloud(3, 0.7, Vec3(0.2, 0.1, -0.4), n3);
+  const MarginFit m3 = max_margin_plane(c3.x, c3.cls, 3);
+  ASSERT_TRUE(m3.ok);
+  EXPECT_LT(angle_between(m3.normal, n3), 1e-12);
+  // Swapping the classes flips the normal.
+  Cloud swapped = c3;
+  for (auto& k : swapped.cls) k = static_cast<signed char>(-k);
+  EXPECT_LT(angle_between(max_margin_plane(swapped.x, swapped.cls, 3).normal, -n3), 1e-12);
+}
+
+TEST(RegressionMaxMargin, OverlappingOrOneClassCloudsAreNotSeparable) {
+  // Interleaved classes: a checkerboard has no separating plane.
+  const Cloud board = lattice_cloud(2, 1.0, Vec3::Zero(), [](const Vec3& r) {
+    return (static_cast<int>(std::floor(2 * r.x())) + static_cast<int>(std::floor(2 * r.y()))) % 2 == 0 ? 1 : -1;
+  });
+  EXPECT_FALSE(max_margin_plane(board.x, board.cls, 2).ok);
+  // One point of beta inside alpha's hull.
+  Cloud inside = lattice_cloud(2, 1.0, Vec3::Zero(), [](const Vec3&) { return -1; });
+  inside.add(Vec3(0.01, 0.02, 0.0), +1);
+  EXPECT_FALSE(max_margin_plane(inside.x, inside.cls, 2).ok);
+  const Cloud one = lattice_cloud(2, 1.0, Vec3::Zero(), [](const Vec3&) { return 1; });
+  EXPECT_FALSE(max_margin_plane(one.x, one.cls, 2).ok);
+  // Touching hulls (a shared point) have no gap either.
+  Cloud touch;
+  touch.add(Vec3(0, 0, 0), -1);
+  touch.add(Vec3(1, 0, 0), -1);
+  touch.add(Vec3(1, 0, 0), +1);
+  touch.add(Vec3(2, 1, 0), +1);
+  EXPECT_FALSE(max_margin_plane(touch.x, touch.cls, 2).ok);
+}
+
 }  // namespace
 }  // namespace cairn::contact

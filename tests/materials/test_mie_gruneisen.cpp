@@ -32,7 +32,8 @@ struct Point {
     F = dF * F;
     MaterialPoint pt{F, L, state.data(), dt};
     pt.dF = &dF;
-    pt.tau_old = &tau;
+    const SymMat3 tau_old = tau;
+    pt.tau_old = &tau_old;
     pt.cell_size = dx;
     pt.temperature = &T;
     tau = m.update(pt);
@@ -74,10 +75,11 @@ TEST(MieGruneisen, EnergyOnTheHugoniotGivesTheReferenceHugoniot) {
     m->initialize_state(st.data());
     st[0] = U;
     Mat3 F = Mat3::Identity() * std::cbrt(1.0 - eta);  // isotropic: no shear stress
-    const Mat3 L = Mat3::Zero(), zero = Mat3::Zero(), dF = Mat3::Identity();
+    const Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
     MaterialPoint pt{F, L, st.data(), 0.0};
     pt.dF = &dF;
-    pt.tau_old = &zero;
+    const SymMat3 zero_stress;
+    pt.tau_old = &zero_stress;
     const Mat3 tau = m->update(pt);
     EXPECT_NEAR(-tau.trace() / (3.0 * F.determinant()), pH, 1e-9 * pH) << eta;
   }

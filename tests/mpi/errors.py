@@ -5,7 +5,10 @@
     same line as in a serial run;
   - a simulation failure (a particle driven out of the grid) exits 3, names the same step, time,
     particle and position as the serial run (particles are named by id on every rank count),
-    writes failure.xdmf and the same history.csv as the serial run.
+    writes failure.xdmf and the same history.csv as the serial run;
+  - the methods that run on one rank only (the WLS method, method.integration = "wls", and the
+    reference FEM, [fem]) are refused on several ranks with exit 2 and one message from rank 0
+    naming the case file and docs/parallel.md.
 Exit 0 only when every check holds; the last line says RESULT: ...
 """
 import argparse
@@ -34,6 +37,7 @@ def main():
     ap.add_argument("--case", required=True, type=Path, help="a case that runs (flip_blocks.toml)")
     ap.add_argument("--out", required=True, type=Path)
     ap.add_argument("--np", type=int, default=2)
+    ap.add_argument("--fem-case", type=Path, help="an input with [fem] (refused on several ranks)")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     mpirun = [args.mpirun, "--oversubscribe", "--allow-run-as-root", "-np", str(args.np)]
@@ -72,12 +76,22 @@ def main():
             (d_s / "history.csv").read_text().splitlines():
         problems.append("failure: history.csv differs from the serial one (imbalance column aside)")
 
+    # One-rank methods: refused on several ranks, once, exit 2.
+    refused = [("wls", [args.cairn, "run", args.case, "--set", 'method.integration="wls"'])]
+    if args.fem_case:
+        refused.append(("fem", [args.cairn, "run", args.fem_case]))
+    for label, cmd in refused:
+        rc, err = run(mpirun + cmd)
+        lines = cairn_lines(err)
+        if rc != 2 or len(lines) != 1 or "one MPI rank only" not in lines[0] or "docs/parallel.md" not in lines[0]:
+            problems.append(f"{label} on {args.np} ranks: exit {rc} (expected 2), printed {lines}")
+
     for p in problems:
         print(p)
     if problems:
         print(f"RESULT: FAIL errors on {args.np} ranks ({len(problems)} problems)")
         return 1
-    print(f"RESULT: PASS errors on {args.np} ranks: input error once with exit 2, failure with exit 3 as serially")
+    print(f"RESULT: PASS errors on {args.np} ranks: input error once with exit 2, failure with exit 3 as serially, WLS/FEM refused once with exit 2")
     return 0
 
 

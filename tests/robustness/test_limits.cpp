@@ -37,6 +37,15 @@ TEST(Robustness, ThreadCountsAreBoundedAndValidated) {
   write_text(d / "case.toml", base_input());
   const CliResult ok = cairn("run case.toml -q -t 3 --set output.directory='\"out\"'", d);
   EXPECT_EQ(ok.code, 0) << ok.output;
+  // -t wins over the input's simulation.threads (the summary names the count used).
+  text = base_input();
+  text.insert(text.find("end_time"), "threads = 1\n");
+  write_text(d / "case.toml", text);
+  const CliResult cli_wins = cairn("run case.toml -t 3 --set output.directory='\"out\"'", d);
+  EXPECT_EQ(cli_wins.code, 0) << cli_wins.output;
+  EXPECT_NE(cli_wins.output.find("with 3 threads"), std::string::npos) << cli_wins.output;
+  const CliResult file_only = cairn("run case.toml --set output.directory='\"out\"'", d);
+  EXPECT_NE(file_only.output.find("with 1 threads"), std::string::npos) << file_only.output;
 }
 
 /// Grids whose node count does not fit the 32-bit node index, refused in the loader.

@@ -101,6 +101,12 @@ TEST(Robustness, ExtremePhysicalValuesWarn) {
             std::string::npos)
       << r.output;
   EXPECT_EQ(cairn_on("check", base_input(), d).output.find("warning"), std::string::npos);
+  // A restart prints the warnings of its input as a run does.
+  const CliResult run = cairn_on("run", text, d, "-q --set output.checkpoint_every=5e-3 --set output.directory='\"out\"'");
+  ASSERT_EQ(run.code, 0) << run.output;
+  const CliResult again = cairn("restart out/checkpoint-0000.h5 -q", d);
+  EXPECT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find("key 'material[0].density': 1e+308 is beyond 1e30"), std::string::npos) << again.output;
 }
 
 TEST(Robustness, EmptySelectionsNameKeyExpectedAndFound) {

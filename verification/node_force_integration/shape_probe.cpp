@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "cairn/transfer/transfer.hpp"
 #include "cairn/shapes/shape_family.hpp"
+#include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
 namespace {
@@ -79,7 +79,7 @@ int run(const Options& o) {
   fam->build(grid, parts, cache);
   std::map<std::int32_t, std::pair<double, Vec<D>>> sums;
   for (std::size_t p = 0; p < parts.n(); ++p) {
-    // Every stencil layout (list or tensor-product) through the cache's entry view.
+    // Every entry of p's stencil, whatever the cache's layout (list or per-axis tensor factors).
     for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>& G) {
       if (o.mode == "stencils") {
         const Vec<D> x = fam->dof_position(grid, node);

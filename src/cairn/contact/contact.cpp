@@ -98,6 +98,7 @@ Contact<D>::Contact(const Config& config, const Grid<D>& grid, const Particles<D
   by_body_ = cfg_.mode == "body";
   twice_ = cfg_.corrections == "twice";
   xpic_correction_ = cfg_.xpic_correction;
+  impulse_ = cfg_.first_correction == "impulse";
   if (by_body_)
     for (const auto& b : config.bodies) field_names_.push_back(b.name);
   else
@@ -265,12 +266,17 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
       });
     for (std::size_t c = 0; c < nc; ++c) cloud_begin_[c + 1] += cloud_begin_[c];
     cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
+    cloud_weight_.resize(cloud_.size());
     std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
     for (std::int64_t k = 0; k < np; ++k) {
       const std::int64_t p = particle_at(k);
       for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
         const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
-        if (c >= 0 && S > 0.0) cloud_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(c)]++)] = static_cast<std::int32_t>(p);
+        if (c >= 0 && S > 0.0) {
+          const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(c)]++);
+          cloud_[at] = static_cast<std::int32_t>(p);
+          cloud_weight_[at] = S;
+        }
       });
     }
   }
@@ -282,10 +288,11 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     std::vector<Vec3> cloud_x;
     std::vector<signed char> cloud_c;
     std::vector<std::int32_t> cloud_p;
+    std::vector<double> cloud_w;
 #pragma omp for schedule(dynamic, 16)
     for (std::int64_t c = 0; c < n_contact; ++c)
       for (std::int32_t k = inter_begin_[static_cast<std::size_t>(c)]; k < inter_begin_[static_cast<std::size_t>(c) + 1]; ++k)
-        geometry(static_cast<std::size_t>(c), particles, cache, mass, cloud_x, cloud_c, cloud_p,
+        geometry(static_cast<std::size_t>(c), particles, cache, mass, cloud_x, cloud_c, cloud_p, cloud_w,
                  inter_[static_cast<std::size_t>(k)]);
   }
 }
@@ -294,7 +301,7 @@ template <int D>
 void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
                           const std::vector<double>& mass, std::vector<Vec3>& cloud_x,
                           std::vector<signed char>& cloud_c, std::vector<std::int32_t>& cloud_p,
-                          Interaction& it) const {
+                          std::vector<double>& cloud_w, Interaction& it) const {
   (void)cache;
   const std::int32_t node = nodes_[c];
   const int nf = n_fields();
@@ -307,6 +314,7 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     cloud_x.clear();
     cloud_c.clear();
     cloud_p.clear();
+    cloud_w.clear();
     for (std::int32_t k = cloud_begin_[c]; k < cloud_begin_[c + 1]; ++k) {
       const std::int32_t p = cloud_[static_cast<std::size_t>(k)];
       const std::int32_t f = field_of(particles, static_cast<std::size_t>(p));
@@ -317,6 +325,7 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
       cloud_x.push_back(to3<D>(offset_from_node(*grid_, node, particles.position[p])));
       cloud_c.push_back(cls);
       cloud_p.push_back(p);
+      cloud_w.push_back(cloud_weight_[static_cast<std::size_t>(k)]);
     }
   }
 
@@ -341,10 +350,20 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     contact::PlaneFitOptions opt;
     opt.dim = D;
     opt.cell_size = grid_->min_cell_size();
+    // Point weights: each particle's shape-function weight S_ip at the node (lr_weights =
+    // "shape"; docs/contact.md: a flat interface through a regular lattice then gets its exact
+    // normal), or w_p = 1 (seed 004 Appendix).
+    if (cfg_.lr_weights != "shape") cloud_w.clear();
     const auto fit = contact::fit_separating_plane(
-        std::span<const Vec3>(cloud_x), std::span<const signed char>(cloud_c), std::span<const double>(),
+        std::span<const Vec3>(cloud_x), std::span<const signed char>(cloud_c), std::span<const double>(cloud_w),
         Vec3::Zero(), opt, cfg_.normal == "linear" ? contact::PlaneFitMethod::linear : contact::PlaneFitMethod::logistic);
     if (fit.ok) n = fit.normal;
+    if (cfg_.lr_refine == "margin") {
+      // Where the clouds are linearly separable, the widest-gap plane: the limit the logistic fit
+      // tends to, free of its finite-scale tilt (docs/contact.md, "Flat interfaces").
+      const auto mm = contact::max_margin_plane(std::span<const Vec3>(cloud_x), std::span<const signed char>(cloud_c), D);
+      if (mm.ok) n = mm.normal;
+    }
   }
   it.normal = n;
   it.area = contact_area(n);
@@ -404,7 +423,7 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
 
 template <int D>
 void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& values, bool momentum, Pass pass,
-                         double time, double dt, std::vector<Vec<D>>* dv) {
+                         double time, double dt, std::vector<Vec<D>>* dv, std::vector<Vec<D>>* dv_impulse) {
   const std::size_t nc = nodes_.size();
   const bool record = pass == Pass::updated;
   const ScopedSeconds lap(correct_seconds_);
@@ -419,7 +438,7 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
   };
   const int nf = n_fields();
   constexpr int max_local = 64;
-  std::array<Vec3, max_local> p, dp_total;
+  std::array<Vec3, max_local> p, dp_total, dp_free;  // dp_free: the part from non-bonded laws
   std::array<double, max_local> m;
   for (std::size_t c = 0; c < nc; ++c) {
     const std::int32_t node = nodes_[c];
@@ -438,6 +457,7 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       m[x - b0] = mass[s];
       p[x - b0] = to3<D>(momentum ? values[s] : Vec<D>(values[s] * mass[s]));
       dp_total[x - b0].setZero();
+      dp_free[x - b0].setZero();
     }
     bool changed = false;
     const int i0 = inter_begin_[c], i1 = inter_begin_[c + 1];
@@ -479,6 +499,7 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
         }
         const Vec3 d = change(it, p[la], m[la], pb, mb, law_of(it.a, other));
         dp_total[la] = d;
+        if (!laws_[static_cast<std::size_t>(law_of(it.a, other))]->bonded()) dp_free[la] = d;
         if (d.squaredNorm() > 0.0) {
           changed = true;
           if (counted) {
@@ -502,6 +523,10 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
           const Vec3 d = change(it, p[la] + dp_total[la], m[la], p[lb] + dp_total[lb], m[lb], it.law);
           dp_total[la] += d;
           dp_total[lb] -= d;
+          if (!laws_[static_cast<std::size_t>(it.law)]->bonded()) {
+            dp_free[la] += d;
+            dp_free[lb] -= d;
+          }
           inter_dp[x - i0] += d;
           biggest = std::max(biggest, d.norm());
           scale = std::max(scale, p[la].norm() + p[lb].norm());
@@ -526,6 +551,11 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       if (momentum) values[s] += dD;
       else values[s] += dD / mass[s];
       if (dv) (*dv)[s] = dD / mass[s];
+      if (dv_impulse) {
+        Vec<D> fD;
+        for (int a = 0; a < D; ++a) fD[a] = dp_free[x - b0][a];
+        (*dv_impulse)[s] = fD / mass[s];
+      }
     }
   }
 }

@@ -48,10 +48,11 @@ class Contact {
   enum class Pass { extrapolated, updated, stress };
   /// Correct `values` (momenta when `momentum`, else velocities; slots) at the contact nodes.
   /// `dv` (slots, zeroed by the caller), when given, receives dp / m at the changed contact
-  /// nodes (extrapolated pass). The updated pass records the
+  /// nodes (extrapolated pass); `dv_impulse` (likewise) the part of it that comes from
+  /// non-bonded (contact) laws. The updated pass records the
   /// contact forces dp / dt per field pair and the number of nodes in contact.
   void correct(const std::vector<double>& mass, std::vector<Vec<D>>& values, bool momentum, Pass pass,
-               double time, double dt, std::vector<Vec<D>>* dv);
+               double time, double dt, std::vector<Vec<D>>* dv, std::vector<Vec<D>>* dv_impulse = nullptr);
 
   /// The grid passed to the constructor now stores another window (a distributed run).
   void grid_changed();
@@ -68,6 +69,9 @@ class Contact {
   /// Unit contact normal per grid node (zero away from contact nodes), for grid snapshots.
   void node_normals(std::vector<Vec3>& out) const;
   [[nodiscard]] bool corrects_extrapolation() const { return twice_; }
+  /// first_correction = "impulse": the first correction's contact (non-bonded) change acts on
+  /// the particle velocities (docs/contact.md, "Chatter").
+  [[nodiscard]] bool impulse() const { return impulse_; }
   /// Cost counters: seconds in prepare (contact nodes, clouds, normals, separations), of which
   /// in the normal and separation fits, seconds in correct, and contact nodes summed over steps.
   [[nodiscard]] double prepare_seconds() const { return prepare_seconds_; }
@@ -87,7 +91,7 @@ class Contact {
   };
   void geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
                 const std::vector<double>& mass, std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c,
-                std::vector<std::int32_t>& cloud_p, Interaction& it) const;
+                std::vector<std::int32_t>& cloud_p, std::vector<double>& cloud_w, Interaction& it) const;
   /// h_n = |(n_a h_a)|: the cell's width along unit n (the cell size for square cells).
   [[nodiscard]] double cell_width(const Vec3& n) const;
   [[nodiscard]] double contact_area(const Vec3& n) const;
@@ -99,6 +103,7 @@ class Contact {
   bool by_body_ = false;
   bool twice_ = true;
   bool xpic_correction_ = true;
+  bool impulse_ = false;
   double small_mass_ = 0.0;
   std::int32_t n_nodes_ = 0;
   std::vector<std::string> field_names_;
@@ -114,6 +119,7 @@ class Contact {
   std::vector<std::int32_t> fields_;
   std::vector<std::int32_t> cloud_begin_;  ///< CSR: particles whose stencil holds contact node c
   std::vector<std::int32_t> cloud_;
+  std::vector<double> cloud_weight_;       ///< S_ip of each cloud entry (lr_weights = "shape")
   std::vector<std::int32_t> inter_begin_;  ///< CSR: interactions of contact node c
   std::vector<Interaction> inter_;
   std::vector<Vec<D>> gradient_;  ///< AG: sum_p G_ip V_p per slot (Eq. 11)

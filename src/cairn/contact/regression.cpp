@@ -16,8 +16,10 @@
 // (D+1)x(D+1) Eigen object: no heap allocation inside a fit.
 #include "cairn/contact/regression.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstddef>
+#include <utility>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
@@ -237,6 +239,135 @@ PlaneFit fit_separating_plane(std::span<const Vec3> x, std::span<const signed ch
     case 3: return fit_impl<3>(x, cls, w, center, opt, method, initial_normal);
     default: return {};
   }
+}
+
+namespace {
+
+/// Closest point to the origin of the convex hull of the points w[0..n) (n <= 4), by trying the
+/// affine hull of every subset and keeping the nearest projection with non-negative barycentric
+/// coordinates. Returns the point and reduces w (and the index pairs) to the subset it lies on.
+Vec3 closest_on_simplex(std::array<Vec3, 4>& w, std::array<std::pair<int, int>, 4>& id, int& n) {
+  double best = std::numeric_limits<double>::infinity();
+  Vec3 best_v = w[0];
+  int best_mask = 1;
+  for (int mask = 1; mask < (1 << n); ++mask) {
+    std::array<int, 4> sub{};
+    int k = 0;
+    for (int i = 0; i < n; ++i)
+      if (mask & (1 << i)) sub[static_cast<std::size_t>(k++)] = i;
+    Eigen::Vector4d lambda = Eigen::Vector4d::Zero();
+    if (k == 1) {
+      lambda(0) = 1.0;
+    } else {
+      // lambda = (1 - sum mu, mu), mu minimising |p0 + sum mu_j (p_j - p0)|.
+      Eigen::Matrix<double, 3, Eigen::Dynamic> q(3, k - 1);
+      const Vec3& p0 = w[static_cast<std::size_t>(sub[0])];
+      for (int j = 1; j < k; ++j) q.col(j - 1) = w[static_cast<std::size_t>(sub[static_cast<std::size_t>(j)])] - p0;
+      const Eigen::MatrixXd qtq = q.transpose() * q;
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(qtq);
+      const Eigen::VectorXd d = ldlt.vectorD();
+      if (ldlt.info() != Eigen::Success || !(d.minCoeff() > 1e-12 * d.cwiseAbs().maxCoeff())) continue;
+      const Eigen::VectorXd mu = ldlt.solve(-(q.transpose() * p0));
+      lambda(0) = 1.0 - mu.sum();
+      for (int j = 1; j < k; ++j) lambda(j) = mu(j - 1);
+      if (!(lambda.head(k).minCoeff() > 0.0)) continue;
+    }
+    Vec3 v = Vec3::Zero();
+    for (int j = 0; j < k; ++j) v += lambda(j) * w[static_cast<std::size_t>(sub[static_cast<std::size_t>(j)])];
+    if (v.squaredNorm() < best) {
+      best = v.squaredNorm();
+      best_v = v;
+      best_mask = mask;
+    }
+  }
+  int k = 0;
+  for (int i = 0; i < n; ++i)
+    if (best_mask & (1 << i)) {
+      w[static_cast<std::size_t>(k)] = w[static_cast<std::size_t>(i)];
+      id[static_cast<std::size_t>(k)] = id[static_cast<std::size_t>(i)];
+      ++k;
+    }
+  n = k;
+  return best_v;
+}
+
+}  // namespace
+
+MarginFit max_margin_plane(std::span<const Vec3> x, std::span<const signed char> cls, int dim) {
+  MarginFit out;
+  if (cls.size() != x.size()) return out;
+  const int d = dim < 1 ? 1 : (dim > 3 ? 3 : dim);
+  auto proj = [&](const Vec3& p) {
+    Vec3 q = Vec3::Zero();
+    for (int a = 0; a < d; ++a) q[a] = p[a];
+    return q;
+  };
+  int first_a = -1, first_b = -1;
+  double scale = 0.0;
+  for (std::size_t p = 0; p < x.size(); ++p) {
+    if (cls[p] < 0 && first_a < 0) first_a = static_cast<int>(p);
+    if (cls[p] > 0 && first_b < 0) first_b = static_cast<int>(p);
+  }
+  if (first_a < 0 || first_b < 0) return out;
+  for (std::size_t p = 0; p < x.size(); ++p)
+    if (cls[p] != 0) scale = std::max(scale, (proj(x[p]) - proj(x[static_cast<std::size_t>(first_a)])).norm());
+  // Support point of the difference set {a - b} along u: argmax a.u - argmin b.u.
+  auto support = [&](const Vec3& u) {
+    int ia = first_a, ib = first_b;
+    double sa = -std::numeric_limits<double>::infinity(), sb = std::numeric_limits<double>::infinity();
+    for (std::size_t p = 0; p < x.size(); ++p) {
+      if (cls[p] == 0) continue;
+      const double s = proj(x[p]).dot(u);
+      if (cls[p] < 0 && s > sa) {
+        sa = s;
+        ia = static_cast<int>(p);
+      } else if (cls[p] > 0 && s < sb) {
+        sb = s;
+        ib = static_cast<int>(p);
+      }
+    }
+    return std::pair<int, int>(ia, ib);
+  };
+  auto point = [&](const std::pair<int, int>& id) {
+    return Vec3(proj(x[static_cast<std::size_t>(id.first)]) - proj(x[static_cast<std::size_t>(id.second)]));
+  };
+  std::array<Vec3, 4> w;
+  std::array<std::pair<int, int>, 4> id;
+  int n = 1;
+  id[0] = {first_a, first_b};
+  w[0] = point(id[0]);
+  Vec3 v = w[0];
+  const double tiny = 1e-12 * std::max(scale, 1e-300);
+  for (int it = 0; it < 64; ++it) {
+    out.iterations = it + 1;
+    if (v.norm() <= tiny) return out;  // the hulls touch: no separating gap
+    const auto sid = support(-v);
+    const Vec3 s = point(sid);
+    // Gilbert's stopping rule: the support point gets no closer along v than v itself.
+    if (v.squaredNorm() - v.dot(s) <= 1e-12 * v.squaredNorm()) {
+      if (!(v.dot(s) > 0.0)) return out;
+      out.normal = -v.normalized();
+      out.gap = v.norm();
+      out.ok = true;
+      return out;
+    }
+    if (n == d + 1) return out;  // cannot grow: numerically stuck
+    bool duplicate = false;
+    for (int i = 0; i < n; ++i) duplicate = duplicate || id[static_cast<std::size_t>(i)] == sid;
+    if (duplicate) {
+      out.normal = -v.normalized();
+      out.gap = v.norm();
+      out.ok = v.dot(s) > 0.0;
+      if (!out.ok) out.normal.setZero();
+      return out;
+    }
+    w[static_cast<std::size_t>(n)] = s;
+    id[static_cast<std::size_t>(n)] = sid;
+    ++n;
+    v = closest_on_simplex(w, id, n);
+    if (n == d + 1) return out;  // the origin lies inside the simplex: the hulls overlap
+  }
+  return out;
 }
 
 double deformed_radius(const Mat3& F, const Vec3& R0, const Vec3& n, int dim) {

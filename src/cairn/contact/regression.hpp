@@ -76,6 +76,20 @@ PlaneFit fit_separating_plane(std::span<const Vec3> x, std::span<const signed ch
                               const PlaneFitOptions& opt, PlaneFitMethod method,
                               const Vec3* initial_normal = nullptr);
 
+/// The maximum-margin (hard support-vector) separation of the two classes of a point cloud:
+/// the plane that separates them with the widest gap, the limit that the logistic fit of seed
+/// 004 Sec. 3.1 approaches as its scale grows without bound ("an alternate approach to obtain
+/// nearly the same results as an SVM"). Its normal is along the shortest vector from the convex
+/// hull of class -1 to that of class +1 (Gilbert's algorithm on the difference set; exact and
+/// finite for point sets). Only the first `dim` components of x matter.
+struct MarginFit {
+  Vec3 normal = Vec3::Zero();  // unit, from class -1 (alpha) toward class +1 (beta)
+  double gap = 0.0;            // distance between the two hulls along normal (> 0 when ok)
+  int iterations = 0;
+  bool ok = false;             // false when the hulls touch or overlap, or a class is missing
+};
+MarginFit max_margin_plane(std::span<const Vec3> x, std::span<const signed char> cls, int dim);
+
 /// Distance from a particle centre to its deformed inscribed ellipsoid along the unit vector n
 /// (seed 004 Eq. 25): n0 = F^{-1} n and 1/R = sqrt(sum_a n0_a^2 / R0_a^2), where R0 holds the
 /// undeformed semi-axes (half the particle edge lengths). Only the first `dim` components of n0

@@ -228,7 +228,8 @@ void Solver::update_stresses(double dt) {
       MaterialPoint point{F, L, state, dt};
       const Mat3 dF = F * F_old.inverse();
       point.dF = &dF;
-      point.tau_old = &tau_[static_cast<std::size_t>(e)];
+      const SymMat3 tau_old = tau_[static_cast<std::size_t>(e)];
+      point.tau_old = &tau_old;
       point.cell_size = altitude(x_[t[0]], x_[t[1]], x_[t[2]]);
       point.temperature = &temperature_[static_cast<std::size_t>(e)];
       tau = mode_ == Mode::plane_stress ? plane_stress_update(*material_, F, point) : material_->update(point);

@@ -14,10 +14,11 @@
 //   /history/columns, /history/rows      string list, rows x columns doubles
 //   /snapshots/times, /snapshots/files   snapshot listing (doubles, string list)
 //   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
-//     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n),
-//     deformation_gradient, kirchhoff_stress and, for APIC runs only, affine_velocity (n x 9,
-//     row-major), material, body (int32, n), id (int64, n: the particle's number; a run on
-//     several MPI ranks stores its particles rank after rank), state (n * n_state_per_particle)
+//     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n,
+//     only for thermal runs), deformation_gradient, kirchhoff_stress and, for APIC runs only,
+//     affine_velocity (n x 9, row-major), material, body (int32, n), id (int64, n: the
+//     particle's number; a run on several MPI ranks stores its particles rank after rank), state
+//     (n * n_state_per_particle); version 1 files may also hold velocity_gradient (not read)
 #pragma once
 
 #include <filesystem>

@@ -31,6 +31,9 @@ struct SimulationConfig {
   double end_time = 0.0;
   double cfl = 0.5;       ///< dt = cfl * h_min / (c_max + max|V|)  (seed 001 Eq. 34)
   double fixed_dt = 0.0;  ///< > 0: use this time step instead of the CFL rule
+  /// adaptive: cfl h / (c_max + max|V|) every step (seed 001 Eq. 34); nominal: cfl h / c_max of
+  /// the undeformed materials, fixed for the run (Eq. 35).
+  std::string time_step = "adaptive";
   long long max_steps = 0;  ///< 0: no limit
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
@@ -63,6 +66,14 @@ struct MethodConfig {
   double full_mass_cfl = 0.0;     ///< periodic FMPM/XPIC CFL_X; 0 = every step
   std::string velocity_bc_method = "constrained";  ///< FMPM/XPIC velocity conditions: velocity|lumped|combined|constrained
   std::string time_integration = "forward_euler";  ///< or central_difference
+  /// mpm: integrate at the particles (every shape family and update); wls: the weighted-least-
+  /// squares PIC method of seed 001 (src/cairn/wls, docs/wls.md).
+  std::string integration = "mpm";
+  double trigger_weight = 0.12;                  ///< WLS TW (seed 001 Sec. 3.5)
+  std::string surface_distance = "distance";     ///< WLS near-surface distance: projection | distance
+  std::string spurious_force = "per_mass";       ///< WLS spurious-node internal force: per_mass | force
+  std::string velocity_gradient = "quadrature";  ///< WLS particle velocity gradient: quadrature | narrow
+  bool filter_acceleration = false;              ///< WLS: planar node filter of the grid velocity increments
 };
 
 /// A material's parameters after validation against the model's declared keys (defaults filled).
@@ -106,6 +117,7 @@ struct BodyConfig {
   std::vector<int> particles_per_cell;  ///< per direction, D values (one given value is repeated)
   std::vector<std::string> velocity;    ///< D expressions in X,Y,Z (numbers are expressions too)
   std::vector<std::string> displacement;  ///< D expressions in X,Y,Z; empty = none
+  std::string arrangement = "cartesian";  ///< cartesian lattice | radial (seed 001 Fig. 4b)
   bool clip = false;  ///< keep the part of the shape inside the grid; false: past the grid is an error
   SourceLocation where;
 };
@@ -196,6 +208,9 @@ struct ContactConfig {
   ContactLawConfig law;             ///< default law of every pair
   std::string normal = "lr";        ///< lr | linear | ag | specified
   std::vector<double> normal_direction;  ///< specified: from the first field to the second
+  std::string lr_weights = "shape"; ///< lr/linear point weights: shape (S_ip) | uniform (seed 004 Appendix)
+  std::string lr_refine = "margin"; ///< lr/linear: margin (max-margin normal when separable) | none
+  std::string first_correction = "extrapolation";  ///< extrapolation (Eq. 34) | impulse (contact changes reach the particles)
   std::string detection = "lr";     ///< lr | velocity | cp | df
   double critical_separation = 0.8; ///< cp: delta_c in cells (seed 004 Eq. 16)
   double touching_tolerance = 1e-3; ///< lr/df: touching when the separation < this many cells
@@ -234,6 +249,8 @@ struct OutputConfig {
   bool snapshots = true;        ///< write HDF5/XDMF particle snapshots
   bool grid_snapshots = false;  ///< also write node fields
   bool checkpoints = true;
+  /// D expressions of the exact displacement u(X, t) (manufactured solutions); empty = none.
+  std::vector<std::string> exact_displacement;
   double checkpoint_wall_interval = 1800.0;  ///< wall-clock seconds between checkpoints; 0 = off
   int compression = 0;          ///< gzip level 0-9 of large HDF5 datasets; 0 = off
 };

@@ -331,6 +331,7 @@ void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::s
                                    dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   if (rows.total == 0 || cols == 0) return;
+  // 2^17 doubles: the rows of one chunk when compressed (creation_properties), so blocks align.
   const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / cols);
   std::vector<double> buffer(std::max<std::size_t>(std::min(rows.count, block), 1) * cols);
   // Collective I/O: every rank takes part in the same number of writes (an empty selection

@@ -118,8 +118,9 @@ void write_doubles(hid_t loc, const std::string& name, const double* data, std::
 void write_doubles_shaped(hid_t loc, const std::string& name, const double* data,
                           const std::vector<std::size_t>& shape, int deflate = 0);
 /// Write a rows x cols double dataset block by block: fill(first, count, buffer) stores rows
-/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB, so an array
-/// whose memory layout differs from the file's is written without a copy of the whole array.
+/// [first, first + count) row-major in buffer. The buffer holds at most about 1 MiB (one chunk
+/// when compressed), so an array whose memory layout differs from the file's is written without
+/// a copy of the whole array.
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
                            const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate = 0);
 /// Write a rows x `file_cols` double dataset from rows x `mem_cols` values in memory (row-major,

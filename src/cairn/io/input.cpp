@@ -25,6 +25,7 @@
 #include "cairn/io/image.hpp"
 #include "cairn/io/schema.hpp"
 #include "cairn/materials/material.hpp"
+#include "cairn/wls/arrangement.hpp"
 
 namespace cairn {
 
@@ -894,6 +895,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.end_time = r.real("end_time");
   s.cfl = r.real("cfl");
   s.fixed_dt = r.real("dt");
+  s.time_step = r.string("time_step");
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
@@ -971,6 +973,12 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   m.full_mass_cfl = r.real("full_mass_cfl");
   m.velocity_bc_method = r.string("velocity_bc_method");
   m.time_integration = r.string("time_integration");
+  m.integration = r.string("integration");
+  m.trigger_weight = r.real("trigger_weight");
+  m.surface_distance = r.string("surface_distance");
+  m.spurious_force = r.string("spurious_force");
+  m.velocity_gradient = r.string("velocity_gradient");
+  m.filter_acceleration = r.boolean("filter_acceleration");
 }
 
 void Loader::read_constants(const toml::table& root, Config& cfg) {
@@ -1200,6 +1208,11 @@ void Loader::read_bodies(const toml::table& root, Config& cfg) {
     if (b.velocity.empty()) b.velocity.assign(n, "0");
     b.displacement = r.expressions("displacement", n, ExpressionVars::initial);
     b.clip = r.boolean("clip");
+    b.arrangement = r.string("arrangement");
+    if (b.arrangement == "radial" && !wls::radial_arrangement_supported(b.shape.kind))
+      r.fail("arrangement", r.given("arrangement"),
+             "cartesian for a " + b.shape.kind + " (radial needs a circle, annulus or sphere shape)",
+             toml_string(b.arrangement));
     b.where = {file_, line_of(t)};
     cfg.bodies.push_back(std::move(b));
   }
@@ -1533,6 +1546,7 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.snapshots = r.boolean("snapshots");
   o.grid_snapshots = r.boolean("grid_snapshots");
   o.checkpoints = r.boolean("checkpoints");
+  o.exact_displacement = r.expressions("exact_displacement", static_cast<std::size_t>(dim_), ExpressionVars::field);
   o.checkpoint_wall_interval = r.real("checkpoint_wall_interval");
   o.compression = r.small_integer("compression");
 }
@@ -1570,6 +1584,9 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
   } else if (r.present("normal_direction")) {
     c.normal_direction = r.reals("normal_direction", static_cast<std::size_t>(dim_), false);
   }
+  c.lr_weights = r.string("lr_weights");
+  c.lr_refine = r.string("lr_refine");
+  c.first_correction = r.string("first_correction");
   c.detection = r.string("detection");
   c.critical_separation = r.real("critical_separation");
   c.touching_tolerance = r.real("touching_tolerance");
@@ -1689,6 +1706,7 @@ std::string config_to_toml(const Config& c) {
   line("end_time", real_text(s.end_time));
   line("cfl", real_text(s.cfl));
   line("dt", real_text(s.fixed_dt));
+  line("time_step", toml_string(s.time_step));
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
@@ -1719,6 +1737,12 @@ std::string config_to_toml(const Config& c) {
     line("full_mass_cfl", real_text(m.full_mass_cfl));
     line("velocity_bc_method", toml_string(m.velocity_bc_method));
     line("time_integration", toml_string(m.time_integration));
+    line("integration", toml_string(m.integration));
+    line("trigger_weight", real_text(m.trigger_weight));
+    line("surface_distance", toml_string(m.surface_distance));
+    line("spurious_force", toml_string(m.spurious_force));
+    line("velocity_gradient", toml_string(m.velocity_gradient));
+    line("filter_acceleration", m.filter_acceleration ? "true" : "false");
   }
 
   if (!c.constants.empty()) {
@@ -1757,6 +1781,7 @@ std::string config_to_toml(const Config& c) {
     line("velocity", array_text(b.velocity, expression_text));
     if (!b.displacement.empty()) line("displacement", array_text(b.displacement, expression_text));
     if (b.clip) line("clip", "true");
+    line("arrangement", toml_string(b.arrangement));
   }
   if (c.fem.enabled) {
     const auto& f = c.fem;
@@ -1862,6 +1887,9 @@ std::string config_to_toml(const Config& c) {
     law_lines(ct.law);
     line("normal", toml_string(ct.normal));
     if (!ct.normal_direction.empty()) line("normal_direction", reals_text(ct.normal_direction));
+    line("lr_weights", toml_string(ct.lr_weights));
+    line("lr_refine", toml_string(ct.lr_refine));
+    line("first_correction", toml_string(ct.first_correction));
     line("detection", toml_string(ct.detection));
     line("critical_separation", real_text(ct.critical_separation));
     line("touching_tolerance", real_text(ct.touching_tolerance));
@@ -1884,6 +1912,8 @@ std::string config_to_toml(const Config& c) {
   line("snapshots", boolean(out.snapshots));
   line("grid_snapshots", boolean(out.grid_snapshots));
   line("checkpoints", boolean(out.checkpoints));
+  if (!out.exact_displacement.empty())
+    line("exact_displacement", array_text(out.exact_displacement, expression_text));
   line("checkpoint_wall_interval", real_text(out.checkpoint_wall_interval));
   line("compression", fmt::format("{}", out.compression));
   return o;

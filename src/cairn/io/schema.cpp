@@ -86,6 +86,12 @@ std::vector<KeyDecl> make_declarations() {
                  "Fixed time step; 0 = use the CFL rule.")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("simulation", "time_step", T::string,
+                 "CFL rule of the time step (without simulation.dt): adaptive = cfl h_min / "
+                 "(c_max + max|v|) every step (seed 001 Eq. 34); nominal = cfl h_min / c_max with "
+                 "the wave speeds of the undeformed materials, fixed for the run (Eq. 35).")
+                .by_default("\"adaptive\"")
+                .choices([] { return std::vector<std::string>{"adaptive", "nominal"}; }));
   k.push_back(Key("simulation", "max_steps", T::integer,
                  "Stop after this many steps; 0 = no limit.")
                 .by_default("0")
@@ -208,6 +214,44 @@ std::vector<KeyDecl> make_declarations() {
                  "Sec. 4.7).")
                 .by_default("\"forward_euler\"")
                 .choices([] { return std::vector<std::string>{"forward_euler", "central_difference"}; }));
+  k.push_back(Key("method", "integration", T::string,
+                 "Where the weak form is integrated: mpm = at the particles (every shape family and "
+                 "update above); wls = the weighted-least-squares PIC method of seed 001 (node "
+                 "fits, cut grid cells with one centroid point per region, central differences; "
+                 "shape, update, order and stress_update are then unused; docs/wls.md).")
+                .by_default("\"mpm\"")
+                .choices([] { return std::vector<std::string>{"mpm", "wls"}; }));
+  k.push_back(Key("method", "trigger_weight", T::real,
+                 "WLS trigger weight TW (seed 001 Sec. 3.5): a node whose particles all have a "
+                 "wide weight W below TW is spurious (constant fit, averaged internal force).")
+                .by_default("0.12")
+                .min(above_zero)
+                .max(1.0));
+  k.push_back(Key("method", "surface_distance", T::string,
+                 "WLS signed distance of near-surface nodes (seed 001 Sec. 3.3): projection of "
+                 "x_surf - x_i on the unit normal (the text) or distance |x_surf - x_i| with the "
+                 "normal's sign (Eq. 17 as printed).")
+                .by_default("\"distance\"")
+                .choices([] { return std::vector<std::string>{"projection", "distance"}; }));
+  k.push_back(Key("method", "spurious_force", T::string,
+                 "WLS internal force of spurious nodes (seed 001 Sec. 4.5): per_mass = the node "
+                 "mass times the mean f_int / m of its well-conditioned neighbours; force = the "
+                 "mean f_int of those neighbours (docs/wls.md).")
+                .by_default("\"per_mass\"")
+                .choices([] { return std::vector<std::string>{"per_mass", "force"}; }));
+  k.push_back(Key("method", "velocity_gradient", T::string,
+                 "WLS particle velocity gradient: quadrature = the gradients at the integration "
+                 "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
+                 "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed, "
+                 "unstable at free surfaces in our runs; docs/wls.md).")
+                .by_default("\"quadrature\"")
+                .choices([] { return std::vector<std::string>{"quadrature", "narrow"}; }));
+  k.push_back(Key("method", "filter_acceleration", T::boolean,
+                 "WLS: replace each node's velocity increment a dt by the planar least-squares "
+                 "fit over it and its neighbours with mass (weights W m), so linear fields pass "
+                 "and the node-to-node zig-zag of small cut cells does not (docs/wls.md; not "
+                 "energy conserving); false = seed 001 as printed.")
+                .by_default("false"));
 
   // [[material]] (the model's own keys come from material_model_info())
   k.push_back(Key("material", "name", T::string,
@@ -254,6 +298,14 @@ std::vector<KeyDecl> make_declarations() {
                  "Keep only the part of the shape inside the grid; false: a shape reaching past "
                  "the grid (by half a particle spacing or more) is an error.")
                 .by_default("false"));
+
+  k.push_back(Key("body", "arrangement", T::string,
+                 "Particle placement: cartesian = the lattice of particles_per_cell; radial = "
+                 "concentric rings (2D) or shells (3D) about h / particles_per_cell apart, for "
+                 "circle, annulus and sphere shapes (seed 001 Fig. 4b). Under method.integration = "
+                 "\"wls\" every body also gets zero-volume surface particles.")
+                .by_default("\"cartesian\"")
+                .choices([] { return std::vector<std::string>{"cartesian", "radial"}; }));
 
   // [[body]] shape kinds
   k.push_back(Key("body.shape.box", "min", T::real_array,
@@ -408,6 +460,20 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("contact", "normal_direction", T::real_array,
                  "specified: the normal, one entry per axis, pointing from the lower-numbered field "
                  "to the higher-numbered one."));
+  k.push_back(Key("contact", "lr_weights", T::string,
+                 "Point weights w_p of the lr and linear fits: shape (each particle's shape-function "
+                 "weight S_ip at the node; a flat interface through a regular particle lattice then "
+                 "gets its exact normal at any offset, docs/contact.md) or uniform (w_p = 1, the "
+                 "seed 004 Appendix).")
+                .by_default("\"shape\"")
+                .choices([] { return std::vector<std::string>{"shape", "uniform"}; }));
+  k.push_back(Key("contact", "lr_refine", T::string,
+                 "Normal of the lr and linear fits: margin (where the two point clouds are linearly "
+                 "separable, the normal of the widest-gap separating plane, the limit the logistic fit "
+                 "approaches; flat interfaces and corners of lattice-filled bodies get their exact "
+                 "normal, docs/contact.md) or none (the fit's own normal, seed 004 Eq. 21).")
+                .by_default("\"margin\"")
+                .choices([] { return std::vector<std::string>{"margin", "none"}; }));
   k.push_back(Key("contact", "detection", T::string,
                  "Contact detection; every method also needs approach, (v_b - v_a).n < 0: lr "
                  "(separation of the point clouds with deformed particle radii, Eq. 22-25), "
@@ -431,6 +497,16 @@ std::vector<KeyDecl> make_declarations() {
                  "26-34); once: only the updated momenta (for comparison).")
                 .by_default("\"twice\"")
                 .choices([] { return std::vector<std::string>{"twice", "once"}; }));
+  k.push_back(Key("contact", "first_correction", T::string,
+                 "How the first correction (on the extrapolated momenta) reaches the particles: "
+                 "extrapolation (seed 004 Eq. 33-34, a = a^a,1 for every law: under FLIP the "
+                 "particles keep the approach velocity the correction removed, which makes frictional "
+                 "sliding chatter) or impulse (its change at contact interfaces is a contact impulse "
+                 "on the particle velocities, V += S dv; bonded, perfect-law changes stay part of the "
+                 "extrapolation; cures the chatter but lets interfaces under sustained compression "
+                 "drift apart, so it is not the default; docs/contact.md).")
+                .by_default("\"extrapolation\"")
+                .choices([] { return std::vector<std::string>{"impulse", "extrapolation"}; }));
   k.push_back(Key("contact", "three_or_more", T::string,
                  "Nodes that see three or more fields: lump (each field against all others lumped, "
                  "Eq. 50) or pairs (the pairs in contact solved together; lumped when three or "
@@ -593,6 +669,12 @@ std::vector<KeyDecl> make_declarations() {
   k.push_back(Key("output", "checkpoints", T::boolean,
                  "Write checkpoints for `cairn restart`.")
                 .by_default("true"));
+  k.push_back(Key("output", "exact_displacement", T::expression_array,
+                 "Exact displacement u(X, t) of a manufactured solution, one expression per axis "
+                 "in X, Y, Z, t and [constants]: history.csv gets displacement_error, the largest "
+                 "|x - X - u(X, t)| over the particles at the row's time, and "
+                 "displacement_error_max, the largest over every step so far (seed 001 Eq. 38); "
+                 "default none."));
   k.push_back(Key("output", "checkpoint_wall_interval", T::real,
                  "Wall-clock seconds between checkpoints (checkpoint-autosave.h5, overwritten); "
                  "0 = none. SIGINT/SIGTERM also write it.")

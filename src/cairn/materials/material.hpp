@@ -13,6 +13,7 @@
 
 #include "cairn/io/config.hpp"
 #include "cairn/io/keys.hpp"
+#include "cairn/math/sym_mat3.hpp"
 #include "cairn/math/types.hpp"
 #include "cairn/util/registry.hpp"
 
@@ -25,9 +26,12 @@ struct MaterialPoint {
   double* state;       ///< the particle's state variables (model-defined length)
   double dt;
   const Mat3* dF = nullptr;       ///< this step's increment exp(L dt), when known
-  const Mat3* tau_old = nullptr;  ///< Kirchhoff stress before this update, when known
+  const SymMat3* tau_old = nullptr;  ///< Kirchhoff stress before this update, when known
   double cell_size = 0.0;         ///< grid cell size (artificial viscosity length)
   double* temperature = nullptr;  ///< the particle's temperature, updated by thermal models
+  /// F is block diagonal [[F_xy, 0], [0, F_zz]] (2D and 1D runs; F_xy is 2x2), which a model
+  /// may use to skip the products with the zero blocks.
+  bool planar = false;
 };
 
 class Material {
@@ -58,10 +62,18 @@ class Material {
   [[nodiscard]] virtual bool uses_temperature() const { return false; }
   /// Speed of the fastest wave at deformation F, used by the CFL time step.
   [[nodiscard]] virtual double wave_speed(const Mat3& F) const = 0;
+  /// Whether wave_speed depends on F (if not, the time step asks once per material, not once
+  /// per particle).
+  [[nodiscard]] virtual bool wave_speed_varies() const { return true; }
 
   /// General stress update; hyperelastic laws need only kirchhoff(). Path-dependent models
   /// override this and keep their history in point.state.
   virtual Mat3 update(const MaterialPoint& point) const { return kirchhoff(point.F); }
+  /// The step's stress update (Task 5) into the particle's stored stress `tau`, which holds the
+  /// stress before the update on entry (point.tau_old may point to it). The default stores
+  /// update(point); models override it to write the six components directly, so that the hot
+  /// loop makes one virtual call per particle and no 3x3 temporary.
+  virtual void update_stress(const MaterialPoint& point, SymMat3& tau) const { tau = update(point); }
 
  private:
   std::string name_;

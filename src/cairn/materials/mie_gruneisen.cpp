@@ -156,7 +156,7 @@ class MieGruneisen final : public Material {
     const Mat3 D = 0.5 * (pt.L + pt.L.transpose());
     const double Dkk = D.trace();
     const double rho0 = density();
-    const Mat3 tau_old = pt.tau_old ? *pt.tau_old : Mat3::Zero();
+    const Mat3 tau_old = pt.tau_old ? pt.tau_old->full() : Mat3::Zero();
     const double U_pred = st[U_] + tau_old.cwiseProduct(D).sum() * pt.dt / rho0;
     double q = 0.0;
     if (Dkk < 0.0 && (A1_ > 0.0 || A2_ > 0.0)) {

@@ -51,6 +51,37 @@ class NeoHookean final : public Material {
     return Mat3::Zero();
   }
 
+  // The same stresses for a planar F (MaterialPoint::planar): B = F F^T and J = det F from the
+  // 2x2 block and F_zz, six components written directly.
+  void update_stress(const MaterialPoint& point, SymMat3& tau) const override {
+    const Mat3& F = point.F;
+    if (!point.planar) {
+      tau = kirchhoff(F);
+      return;
+    }
+    const double Fzz = F(2, 2);
+    const double J = (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * Fzz;
+    const double Bxx = F(0, 0) * F(0, 0) + F(0, 1) * F(0, 1), Byy = F(1, 0) * F(1, 0) + F(1, 1) * F(1, 1);
+    const double Bxy = F(0, 0) * F(1, 0) + F(0, 1) * F(1, 1), Bzz = Fzz * Fzz;
+    double pressure_part = 0.0, shear = c_.shear, shift = 1.0;  // tau = p I + shear (B - shift I)
+    switch (form_) {
+      case Form::ln_j:
+        pressure_part = c_.lambda * std::log(J);
+        break;
+      case Form::j_squared:
+        pressure_part = 0.5 * c_.lambda * (J * J - 1.0);
+        break;
+      case Form::isochoric:
+        pressure_part = 0.5 * c_.bulk() * (J * J - 1.0);
+        shear = c_.shear * std::pow(J, -2.0 / 3.0);
+        shift = (Bxx + Byy + Bzz) / 3.0;
+        break;
+    }
+    auto& v = tau.voigt();  // xx, yy, zz, yz, xz, xy
+    v = {pressure_part + shear * (Bxx - shift), pressure_part + shear * (Byy - shift),
+         pressure_part + shear * (Bzz - shift), 0.0, 0.0, shear * Bxy};
+  }
+
   double energy_density(const Mat3& F) const override {
     const double J = F.determinant();
     const double lnJ = std::log(J);
@@ -70,6 +101,7 @@ class NeoHookean final : public Material {
   double wave_speed(const Mat3&) const override {
     return std::sqrt((c_.lambda + 3.0 * c_.shear) / density());  // seed 001 Eq. 33
   }
+  bool wave_speed_varies() const override { return false; }
 
  private:
   ElasticConstants c_;

@@ -40,6 +40,14 @@ class SymMat3 {
       if (!std::isfinite(x)) return false;
     return true;
   }
+  /// The top-left D x D block as a full matrix.
+  template <int D>
+  [[nodiscard]] Eigen::Matrix<double, D, D> block() const {
+    Eigen::Matrix<double, D, D> m;
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) m(i, j) = (*this)(i, j);
+    return m;
+  }
   /// The top-left D x D block times g, summed in the order of a Mat3 block product.
   template <int D>
   [[nodiscard]] Vec<D> times(const Vec<D>& g) const {

@@ -27,40 +27,96 @@
 
 namespace cairn {
 
-template <int D, class Kernel>
-void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Particles<D>& particles,
-                          TransferCache<D>& cache) {
-  constexpr int max_width = 8;
-  const int width = kernel.width(particles);
-  if (width > max_width)
-    throw std::invalid_argument("shape family: a stencil " + std::to_string(width) +
-                                " nodes wide per axis exceeds the limit of " +
-                                std::to_string(max_width) +
-                                " (smoothing length or particle size too large for the cell size)");
-  // Widths 2-4 (every family at ordinary particle sizes) keep the per-axis factors (tensor
-  // layout); wider GIMP stencils are expanded into the list layout.
-  const bool factored = width >= 2 && width <= 4;
-  int slots = 1;
-  for (int a = 0; a < D; ++a) slots *= width;
-  const auto n = particles.n();
-  if (factored) cache.reserve_tensor(n, width);
-  else cache.reserve(n, slots);
-  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+namespace tensor_product_detail {
 
-  std::int64_t first_bad = INT64_MAX;
-  IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+/// Multi-index of the kernel's k-th node along axis a from `first` (open-knot splines map their
+/// extra functions to ghost slots).
+template <class Kernel>
+int node_along(const Kernel& kernel, int a, int first, int k) {
+  if constexpr (requires { kernel.node_of(a, first, k); }) return kernel.node_of(a, first, k);
+  return first + k;
+}
+
+/// Tensor layout with W nodes per axis: per axis the storage offsets, weights and derivatives.
+/// Returns through the reach and the lowest failing particle.
+template <int W, int D, class Kernel>
+void build_factored(const Kernel& kernel, const Grid<D>& grid, const Particles<D>& particles,
+                    TransferCache<D>& cache, IVec<D>& lo, IVec<D>& hi, std::int64_t& first_bad) {
+  const auto n = static_cast<std::int64_t>(particles.n());
+  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
 #pragma omp parallel
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
 #pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < static_cast<std::int64_t>(n); ++p) {
+    for (std::int64_t p = 0; p < n; ++p) {
+      const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * W];
+      double* value_out = &cache.axis_value[static_cast<std::size_t>(p) * D * 2 * W];
+      if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
+        bad_t = std::min<std::int64_t>(bad_t, p);
+        std::fill(node_out, node_out + D * W, 0);
+        std::fill(value_out, value_out + D * 2 * W, 0.0);
+        continue;
+      }
+      for (int a = 0; a < D; ++a) {
+        double w[W] = {}, dw[W] = {};  // a kernel may leave them unset outside its domain
+        const int first = kernel.eval(particles, p, a, xi[a], w, dw);
+        const int cell = static_cast<int>(std::floor(xi[a]));
+        std::int32_t offset[W];
+        std::int32_t stored = -1;
+        for (int k = 0; k < W; ++k) {
+          const int j = node_along(kernel, a, first, k);
+          offset[k] = grid.axis_index(a, j);
+          if (offset[k] >= 0) stored = offset[k];
+          // Every entry is visited by the transfers, so the reach is the full width.
+          lo_t[a] = std::max(lo_t[a], cell - j);
+          hi_t[a] = std::max(hi_t[a], j - cell - 1);
+        }
+        // A node beyond the ghost layers is an error where the particle has weight there; where
+        // it has none (phi = dphi = 0) the entry is kept with a stored neighbour's offset, so
+        // the transfers add zeros to a node of the stencil.
+        for (int k = 0; k < W; ++k) {
+          if (offset[k] < 0) {
+            if (w[k] != 0.0 || dw[k] != 0.0 || stored < 0) bad_t = std::min<std::int64_t>(bad_t, p);
+            offset[k] = std::max(stored, 0);
+          }
+          node_out[a * W + k] = offset[k];
+          value_out[a * 2 * W + k] = w[k];
+          value_out[a * 2 * W + W + k] = dw[k] * inv_h[a];
+        }
+      }
+    }
+#pragma omp critical
+    {
+      first_bad = std::min(first_bad, bad_t);
+      lo = lo.cwiseMax(lo_t);
+      hi = hi.cwiseMax(hi_t);
+    }
+  }
+}
+
+/// List layout: the expanded entries (S, G) with S != 0 or G != 0, for any width.
+template <int D, class Kernel>
+void build_expanded(const Kernel& kernel, int width, const Grid<D>& grid, const Particles<D>& particles,
+                    TransferCache<D>& cache, IVec<D>& lo, IVec<D>& hi, std::int64_t& first_bad) {
+  constexpr int max_width = 8;
+  int slots = 1;
+  for (int a = 0; a < D; ++a) slots *= width;
+  const auto n = static_cast<std::int64_t>(particles.n());
+  const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+#pragma omp parallel
+  {
+    IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
+    std::int64_t bad_t = INT64_MAX;
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
       std::array<std::array<double, max_width>, D> w{}, dw{};
       IVec<D> first;
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       if (!Grid<D>::indexable(xi)) {  // far outside (or NaN): no cell index to form
         bad_t = std::min<std::int64_t>(bad_t, p);
-        if (!factored) cache.count[p] = 0;
+        cache.count[p] = 0;
         continue;
       }
       IVec<D> cell;
@@ -72,37 +128,12 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
       std::array<std::array<std::int32_t, max_width>, D> offset{};
       for (int a = 0; a < D; ++a)
         for (int k = 0; k < width; ++k) {
-          int j = first[a] + k;
-          if constexpr (requires { kernel.node_of(a, first[a], k); }) j = kernel.node_of(a, first[a], k);
+          const int j = node_along(kernel, a, first[a], k);
           offset[a][k] = grid.axis_index(a, j);
-          // The tensor layout visits every entry, so its reach is the full width.
-          if (!factored && w[a][k] == 0.0 && dw[a][k] == 0.0) continue;  // outside the support
+          if (w[a][k] == 0.0 && dw[a][k] == 0.0) continue;  // outside the support: no reach
           lo_t[a] = std::max(lo_t[a], cell[a] - j);
           hi_t[a] = std::max(hi_t[a], j - cell[a] - 1);
         }
-      if (factored) {
-        // A node beyond the ghost layers is an error where the particle has weight there; where
-        // it has none (phi = dphi = 0) the entry is kept with a stored neighbour's offset, so the
-        // transfers add zeros to a node of the stencil.
-        std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * width];
-        double* value_out = &cache.axis_value[static_cast<std::size_t>(p) * D * 2 * width];
-        for (int a = 0; a < D; ++a) {
-          std::int32_t stored = -1;
-          for (int k = 0; k < width; ++k)
-            if (offset[a][k] >= 0) stored = offset[a][k];
-          for (int k = 0; k < width; ++k) {
-            std::int32_t off = offset[a][k];
-            if (off < 0) {
-              if (w[a][k] != 0.0 || dw[a][k] != 0.0 || stored < 0) bad_t = std::min<std::int64_t>(bad_t, p);
-              off = std::max(stored, 0);
-            }
-            node_out[a * width + k] = off;
-            value_out[a * 2 * width + k] = w[a][k];
-            value_out[a * 2 * width + width + k] = dw[a][k] * inv_h[a];
-          }
-        }
-        continue;
-      }
       const std::size_t base = static_cast<std::size_t>(p) * slots;
       int used = 0;
       std::array<int, D> k{};  // odometer over the width^D box, axis 0 fastest
@@ -139,6 +170,37 @@ void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Parti
       lo = lo.cwiseMax(lo_t);
       hi = hi.cwiseMax(hi_t);
     }
+  }
+}
+
+}  // namespace tensor_product_detail
+
+template <int D, class Kernel>
+void build_tensor_product(const Kernel& kernel, const Grid<D>& grid, const Particles<D>& particles,
+                          TransferCache<D>& cache) {
+  using namespace tensor_product_detail;
+  constexpr int max_width = 8;
+  const int width = kernel.width(particles);
+  if (width > max_width)
+    throw std::invalid_argument("shape family: a stencil " + std::to_string(width) +
+                                " nodes wide per axis exceeds the limit of " +
+                                std::to_string(max_width) +
+                                " (smoothing length or particle size too large for the cell size)");
+  // Widths 2-4 (every family at ordinary particle sizes) keep the per-axis factors (tensor
+  // layout); wider GIMP stencils are expanded into the list layout.
+  const auto n = particles.n();
+  std::int64_t first_bad = INT64_MAX;
+  IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+  if (width >= 2 && width <= 4) {
+    cache.reserve_tensor(n, width);
+    if (width == 2) build_factored<2>(kernel, grid, particles, cache, lo, hi, first_bad);
+    else if (width == 3) build_factored<3>(kernel, grid, particles, cache, lo, hi, first_bad);
+    else build_factored<4>(kernel, grid, particles, cache, lo, hi, first_bad);
+  } else {
+    int slots = 1;
+    for (int a = 0; a < D; ++a) slots *= width;
+    cache.reserve(n, slots);
+    build_expanded(kernel, width, grid, particles, cache, lo, hi, first_bad);
   }
   cache.reach_lo = lo;
   cache.reach_hi = hi;

@@ -4,6 +4,11 @@
 // edge lengths h / ppc. An optional displacement field u(X) places it at x = X + u(X) with
 // F = I + grad u (central differences), and its initial velocity is evaluated at X.
 //
+// arrangement = "radial" replaces the lattice of a circle, annulus or sphere by concentric rings
+// or shells (seed 001 Fig. 4b), each particle with the area/volume of its piece; under
+// method.integration = "wls" every body also gets zero-volume surface particles
+// (wls/arrangement.hpp). Seeds outside the grid are dropped, like lattice points.
+//
 // An image shape (2D) keeps X when the pixel under it has a grey level in [level_min,
 // level_max]: pixel (col, row) of a W x H picture covers [ox + col s, ox + (col + 1) s) x
 // [oy + (H - 1 - row) s, oy + (H - row) s), so row 0 (the top of the picture) lies at the
@@ -28,6 +33,7 @@
 #include "cairn/io/image.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/wls/arrangement.hpp"
 
 namespace cairn {
 namespace {
@@ -180,17 +186,47 @@ void create_particles(const Config& config, const Grid<D>& grid,
       span[a] = std::max(0LL, box.hi[a] - box.lo[a] + 1);
       total *= span[a];
     }
-    for (long long k = 0; k < total; ++k) {
-      long long rem = k;
-      Vec<D> X;
+    // The lattice, or the seed 001 Fig. 4b rings/shells; WLS adds surface particles (zero volume)
+    // between lattice points in and out of the shape, on a lattice one point wider than the box.
+    const bool radial = body.arrangement == "radial";
+    const bool surface = config.method.integration == "wls";
+    std::vector<wls::Seed<D>> seeds;
+    if (radial) {
+      for (auto& s : wls::radial_arrangement<D>(body.shape, lp.minCoeff(), surface))
+        if ((s.X.array() >= grid.origin().array()).all() && (s.X.array() < grid.extent_max().array()).all())
+          seeds.push_back(s);
+    } else if (surface && total > 0) {
+      auto in = [&](const Vec<D>& X) { return inside<D>(body.shape, image.get(), X); };
+      Vec<D> first;
+      IVec<D> count;
       for (int a = 0; a < D; ++a) {
-        const long long ia = box.lo[a] + rem % span[a];
-        rem /= span[a];
-        X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
+        const long long lo = std::max(0LL, box.lo[a] - 1);
+        const long long hi = std::min(static_cast<long long>(grid.n_cells()[a]) * ppc[a] - 1, box.hi[a] + 1);
+        first[a] = grid.origin()[a] + (static_cast<double>(lo) + 0.5) * lp[a];
+        count[a] = static_cast<int>(hi - lo + 1);
       }
-      if (!inside<D>(body.shape, image.get(), X)) continue;
+      for (const Vec<D>& X : wls::lattice_surface_points<D>(in, first, lp, count)) seeds.push_back({X, 0.0});
+    }
+    const long long n_lattice = radial ? 0 : total;
+    for (long long k = 0; k < n_lattice + static_cast<long long>(seeds.size()); ++k) {
+      Vec<D> X;
+      double particle_volume = vol, particle_mass = mass;
+      if (k < n_lattice) {
+        long long rem = k;
+        for (int a = 0; a < D; ++a) {
+          const long long ia = box.lo[a] + rem % span[a];
+          rem /= span[a];
+          X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
+        }
+        if (!inside<D>(body.shape, image.get(), X)) continue;
+      } else {
+        const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
+        X = s.X;
+        particle_volume = s.measure * thickness;
+        particle_mass = materials[mat]->density() * particle_volume;
+      }
       const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
-      particles.add(X, v0, mass, vol, lp, mat, static_cast<std::int32_t>(b));
+      particles.add(X, v0, particle_mass, particle_volume, lp, mat, static_cast<std::int32_t>(b));
       {
         const std::size_t p = particles.n() - 1;
         if (particles.has_temperature) particles.temperature[p] = materials[mat]->initial_temperature();

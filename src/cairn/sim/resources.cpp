@@ -195,11 +195,13 @@ template <int D>
 void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n_state, int stencil_width) {
   // Bytes per particle (particles/particles.hpp: 4 D-vectors, 3 scalars, 4 Mat3, 2 int32, the
   // material state), the simulation's per-particle scratch (3 vectors and a scalar), the
-  // transfer cache (per stencil node: node and slot int32, weight, gradient; cell, count, order)
-  // and one more copy of the particle arrays (checkpoint and snapshot buffers).
+  // transfer cache (per stencil node: node and slot int32, weight, gradient; cell, count, order).
+  // An upper bound: the tensor layout of tensor-product families stores less, and snapshots and
+  // checkpoints are written from the particle arrays through a small block buffer (no second
+  // copy; docs/performance.md measures about 360 bytes per particle in 2D and 450 in 3D).
   const double slots = std::pow(static_cast<double>(stencil_width), D);
   const double particle_arrays = 8.0 * (4 * D + 3 + 4 * 9 + n_state) + 8.0;
-  const double per_particle = 2.0 * particle_arrays + 8.0 * (2 * D + 1) + 4.0 +
+  const double per_particle = particle_arrays + 8.0 * (2 * D + 1) + 4.0 +
                               slots * (4.0 + 4.0 + 8.0 + 8.0 * D) + 4.0 * D + 2.0 + 12.0;
   // Bytes per node and field: NodeField (mass, 7 vectors) and the simulation's 3 node vectors.
   const double per_node = 8.0 + 8.0 * D * 10.0;

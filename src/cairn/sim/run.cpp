@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <sys/ioctl.h>
+#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <exception>
 #include <regex>
 
+#include "cairn/bc/expression.hpp"
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/run.hpp"
 #include "cairn/io/checkpoint.hpp"
@@ -23,6 +25,7 @@
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/integrator.hpp"
 
 namespace cairn {
 namespace {
@@ -102,6 +105,10 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
     for (int a = 0; a < D; ++a) columns.push_back(fmt::format("reaction_{}_{}", name, "xyz"[a]));
   for (const auto& wall : sim.velocity_conditions().walls())
     columns.push_back(fmt::format("wall_{}_position", wall.name()));
+  if (!sim.config().output.exact_displacement.empty()) {
+    columns.push_back("displacement_error");
+    columns.push_back("displacement_error_max");
+  }
   if (const auto* c = sim.contact()) {
     columns.push_back("contact_nodes");
     columns.push_back("contact_active");
@@ -145,10 +152,16 @@ class Runner {
     checkpoint_.interval = out.checkpoint_every;
     if (comm_.is_root()) {  // rank 0 alone manages the folder (docs/parallel.md)
       std::filesystem::create_directories(dir_);
+      // WLS (one rank only, refused on several): the integration regions (cut cells) beside
+      // every particle snapshot, wls_cells.xdmf.
+      if (sim_.wls()) cells_ = std::make_unique<SnapshotWriter<D>>(dir_, "wls_cells");
       remove_orphan_temporaries(dir_);
       remove_orphan_temporaries(dir_ / "snapshots");
     }
     comm_.barrier();
+    if (!out.exact_displacement.empty())
+      for (int t = 0; t < omp_get_max_threads(); ++t)
+        exact_.push_back(std::make_unique<ExpressionVector<D>>(out.exact_displacement, config_.constants));
   }
 
   /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
@@ -185,6 +198,7 @@ class Runner {
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
+    if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
     snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
     history_.done = static_cast<long long>(data.scalars.at("history_done"));
     checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
@@ -194,6 +208,13 @@ class Runner {
     // Every output ends where the checkpoint stands, before the first new step.
     flush_history();
     snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
+    if (cells_) {
+      // The region files are written in step with the particle files: same index, other stem.
+      auto entries = data.snapshot_entries;
+      for (auto& [time, file] : entries)
+        if (file.rfind("particles-", 0) == 0) file = "wls_cells-" + file.substr(10);
+      cells_->restore(entries, data.snapshot_next_index);
+    }
     restarted_ = true;
   }
 
@@ -208,6 +229,7 @@ class Runner {
       if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
         std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
+      measure_error();
       write_history_row();
       write_snapshot();
     }
@@ -221,6 +243,7 @@ class Runner {
       }
       last_dt_ = dt;
       max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
+      measure_error();
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
       const double t = sim_.time();
       wrote_history = wrote_snapshot = false;
@@ -288,6 +311,26 @@ class Runner {
     return t.kinetic_energy + t.strain_energy;
   }
 
+  /// Eq. 38 of seed 001: the largest |x_p - X_p - u(X_p, t)| now, and over every step so far.
+  void measure_error() {
+    if (exact_.empty()) return;
+    const auto& P = sim_.particles();
+    const auto n = static_cast<std::int64_t>(P.n());
+    const double t = sim_.time();
+    double worst = 0.0;
+#pragma omp parallel reduction(max : worst)
+    {
+      auto& u = *exact_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+      for (std::int64_t p = 0; p < n; ++p) {
+        const Vec<D>& X = P.reference_position[p];
+        worst = std::max(worst, (P.position[p] - X - u(X, X, t)).norm());
+      }
+    }
+    error_now_ = comm_.max(worst);  // over every rank's owned particles
+    error_max_ = std::max(error_max_, error_now_);
+  }
+
   void write_history_row() {
     const Totals t = sim_.totals();
     const double total = t.kinetic_energy + t.strain_energy;
@@ -298,6 +341,10 @@ class Runner {
     for (const auto& r : sim_.velocity_conditions().reactions())
       for (int a = 0; a < D; ++a) row.push_back(r[a]);
     for (const auto& wall : sim_.velocity_conditions().walls()) row.push_back(wall.position());
+    if (!exact_.empty()) {
+      row.push_back(error_now_);
+      row.push_back(error_max_);
+    }
     if (const auto* c = sim_.contact()) {
       row.push_back(static_cast<double>(c->contact_nodes()));
       row.push_back(static_cast<double>(c->active_nodes()));
@@ -353,6 +400,8 @@ class Runner {
     }
     else
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    // The regions of the last step (none before the first step).
+    if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
 
   /// A numbered checkpoint-NNNN.h5, or (autosave: wall-clock interval, signals) the one
@@ -375,6 +424,7 @@ class Runner {
                     {"checkpoint_index", static_cast<double>(checkpoint_index_)}};
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
+    if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
@@ -474,6 +524,9 @@ class Runner {
   Schedule history_, snapshot_, checkpoint_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
+  std::unique_ptr<SnapshotWriter<D>> cells_;  ///< WLS integration regions
+  std::vector<std::unique_ptr<ExpressionVector<D>>> exact_;  ///< [output] exact_displacement, per thread
+  double error_now_ = 0.0, error_max_ = 0.0;
   double initial_energy_ = 0.0;
   double last_dt_ = 0.0;
   int checkpoint_index_ = 0;
@@ -516,7 +569,18 @@ std::string time_step_note(const Config& config) {
       k, cfl, max_cfl, limit);
 }
 
+namespace {
+/// The WLS method of seed 001 keeps its own node fits and integration regions, which have no
+/// ghost exchange: refused on several ranks (every rank throws; rank 0 prints; exit 2).
+void refuse_wls_on_ranks(const Config& config, const std::string& where) {
+  if (config.method.integration == "wls" && Comm::world().parallel())
+    throw std::invalid_argument(where + ": method.integration = \"wls\" runs on one MPI rank only "
+                                "(docs/parallel.md); run it without mpirun or with -np 1");
+}
+}  // namespace
+
 RunSummary run(const Config& config, const RunOptions& options) {
+  refuse_wls_on_ranks(config, config.source_file);
   if (config.fem.enabled) {
     if (Comm::world().parallel())
       throw std::invalid_argument(config.source_file + ": [fem] runs on one MPI rank only (docs/parallel.md); run "
@@ -538,6 +602,11 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+  refuse_wls_on_ranks(config, file.string());
+  // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints
+  // them (rank 0 alone on several ranks).
+  if (Comm::world().is_root())
+    for (const auto& w : config.warnings) std::fprintf(stderr, "cairn: warning: %s\n", w.c_str());
   return run_dim<D>(config, options, &data);
 }
 }  // namespace

@@ -17,6 +17,7 @@
 #include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/integrator.hpp"
 
 namespace cairn {
 
@@ -63,13 +64,15 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   int n_state = 0;
   for (const auto& m : materials_) n_state = std::max(n_state, m->n_state());
   particles_.n_state_per_particle = n_state;
-  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   particles_.has_affine = scheme_->affine();
   particles_.has_temperature = config_.thermal.conduction;
   for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
+  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
   create_particles<D>(config_, grid_, materials_, mode_, particles_);
   particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
+  material_in_use_.assign(materials_.size(), 0);
+  for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
   if (config_.thermal.conduction) {  // on the whole grid here; windows in allocate_nodes
     std::vector<double> k, cp;
     for (const auto& mc : config_.materials) {
@@ -96,6 +99,38 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
+  if (config_.method.integration == "wls") {
+    // The WLS method (seed 001) replaces the particle transfers; features that act through
+    // them are not defined for it.
+    const char* unsupported = D == 1                          ? "a 1D simulation"
+                              : config_.contact.enabled()     ? "[contact]"
+                              : config_.thermal.conduction    ? "[thermal] conduction"
+                              : !config_.tractions.empty()    ? "[[traction]]"
+                              : !config_.walls.empty()        ? "[[wall]]"
+                                                              : nullptr;
+    for (int a = 0; a < D && !unsupported; ++a)
+      if (grid_.periodic(a)) unsupported = "periodic faces";
+    if (unsupported)
+      throw std::invalid_argument(std::string("method.integration = \"wls\" does not support ") + unsupported +
+                                  " (docs/wls.md)");
+    wls::Options o;
+    o.trigger_weight = config_.method.trigger_weight;
+    o.projected_distance = config_.method.surface_distance == "projection";
+    o.average_per_mass = config_.method.spurious_force == "per_mass";
+    o.quadrature_gradient = config_.method.velocity_gradient == "quadrature";
+    // A symmetry face is a mirror plane of the body when the body reaches it at the start
+    // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
+    for (int f = 0; f < 2 * D; ++f) {
+      if (config_.boundary.face[f] != FaceCondition::symmetry) continue;
+      const int a = f / 2;
+      const double plane = f % 2 ? grid_.extent_max()[a] : grid_.origin()[a];
+      for (std::size_t p = 0; p < particles_.n() && !o.mirror[f]; ++p)
+        o.mirror[f] = std::abs(particles_.position[p][a] - plane) < 0.5 * grid_.cell_size()[a];
+    }
+    o.thickness = config_.simulation.thickness;
+    wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
+  }
+
   if (!config_.body_force.expression.empty()) {
     const int n_threads = omp_get_max_threads();
     for (int t = 0; t < n_threads; ++t)
@@ -121,6 +156,13 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     grid_ = distribution_.window(whole_, reach_);
   }
   allocate_nodes();
+  if (wls_) {
+    // The initial node fields and integration regions, so that output at t = 0 shows them.
+    wls_->build_stencils(grid_, particles_);
+    compute_body_forces();
+    wls_->collect(grid_, particles_, material_density_, body_force_.empty() ? nullptr : &body_acceleration_,
+                  nodes_, body_force_.empty() ? nullptr : &node_body_force_);
+  }
 }
 
 template <int D>
@@ -133,6 +175,7 @@ void Simulation<D>::allocate_nodes() {
   if (contact_) {
     contact_->grid_changed();
     contact_dv_.assign(n_slots(), Vec<D>::Zero());
+    contact_impulse_.assign(n_slots(), Vec<D>::Zero());
     totals_.mass.assign(grid_.n_nodes(), 0.0);
     totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
     field_offset_.resize(particles_.n());
@@ -267,31 +310,50 @@ void Simulation<D>::setup_grid() {
     cells[a] = std::llround(g.extent[a] / g.cell_size[a]);
     periodic[a] = wraps[a] = config_.boundary.face[2 * a] == FaceCondition::periodic;
   }
-  check_node_count(config_, cells, wraps, shape_->ghost_layers(), velocity_fields(config_));
+  // WLS's wide weight reaches one node beyond a particle's nearest node.
+  const int ghost = std::max(shape_->ghost_layers(), config_.method.integration == "wls" ? 1 : 0);
+  check_node_count(config_, cells, wraps, ghost, velocity_fields(config_));
   for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
-  grid_ = Grid<D>(origin, n_cells, h, shape_->ghost_layers(), periodic);
+  grid_ = Grid<D>(origin, n_cells, h, ghost, periodic);
   whole_ = grid_;
 }
 
 template <int D>
 double Simulation<D>::max_signal_speed() const {
+  // Materials whose wave speed does not depend on F are asked once (if they have particles);
+  // max |V| is sqrt(max |V|^2), the same number. Maxima over the owned particles, then over the
+  // ranks (order-independent).
   const auto n = static_cast<std::int64_t>(n_owned());
-  double c_max = 0.0, v_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v_max)
-  for (std::int64_t p = 0; p < n; ++p) {
-    c_max = std::max(c_max, materials_[particles_.material[p]]->wave_speed(particles_.deformation_gradient[p]));
-    v_max = std::max(v_max, particles_.velocity[p].norm());
+  const auto n_materials = static_cast<std::int32_t>(materials_.size());
+  double c_max = 0.0;
+  std::vector<char> varies(materials_.size(), 0);
+  for (std::int32_t m = 0; m < n_materials; ++m) {
+    varies[m] = materials_[m]->wave_speed_varies();
+    if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
   }
-  double both[2] = {c_max, v_max};
+  double v2_max = 0.0;
+#pragma omp parallel for reduction(max : c_max, v2_max)
+  for (std::int64_t p = 0; p < n; ++p) {
+    const std::int32_t m = particles_.material[p];
+    if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
+    v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
+  }
+  double both[2] = {c_max, v2_max};
   distribution_.comm().max(both, 2);
-  return both[0] + both[1];
+  return both[0] + std::sqrt(both[1]);
 }
 
 template <int D>
 double Simulation<D>::next_dt() const {
   const auto& s = config_.simulation;
   double dt = s.fixed_dt;
-  if (dt <= 0.0) {
+  if (dt <= 0.0 && s.time_step == "nominal") {
+    // seed 001 Eq. 35: the wave speed of the undeformed materials, no particle speed.
+    double c_max = 0.0;
+    for (const auto& m : materials_) c_max = std::max(c_max, m->wave_speed(Mat3::Identity()));
+    dt = s.cfl * grid_.min_cell_size() / c_max;
+    if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
+  } else if (dt <= 0.0) {
     dt = s.cfl * grid_.min_cell_size() / max_signal_speed();  // seed 001 Eq. 34
     if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
   }
@@ -315,6 +377,10 @@ std::vector<std::pair<std::string, double>> Simulation<D>::stage_times() const {
 
 template <int D>
 void Simulation<D>::step(double dt) {
+  if (wls_) {
+    wls_step(dt);
+    return;
+  }
   auto clock = StageClock::now();
   auto lap = [&](int stage) {
     const auto now = StageClock::now();
@@ -377,7 +443,14 @@ void Simulation<D>::step_stages(double dt, FullMass need, bool fmpm_velocities, 
     // seed 000 Task 3: v+ = m~_k^-1 p+ (FMPM) or v = m~_k^-1 p (XPIC, blends).
     full_mass_velocity(need == FullMass::of_updated ? nodes_.velocity_new : nodes_.velocity,
                        nodes_.velocity_full, k);
-    if (contact_ && contact_->xpic_correction()) subtract_contact_term(nodes_.velocity_full, k);
+    if (contact_ && contact_->xpic_correction()) {
+      subtract_contact_term(nodes_.velocity_full, k);
+      // The dv term comes after the conditions that full_mass_velocity imposed: impose them
+      // again, so that a held node that is also a contact node keeps its condition.
+      if (config_.method.velocity_bc_method != "lumped")
+        impose_conditions(nodes_.velocity_full, need == FullMass::of_updated ? VelocityConditions<D>::When::end
+                                                                              : VelocityConditions<D>::When::start);
+    }
   }
   lap(3);
   update_particles(dt);
@@ -408,6 +481,56 @@ void Simulation<D>::step_stages(double dt, FullMass need, bool fmpm_velocities, 
     if (distributed()) share_flux = [this](std::vector<Vec<D>>& flux) { refresh_ghosts(flux); };
     conduction_->step(cache_, particles_, dt, share_flux);
   }
+}
+
+template <int D>
+void Simulation<D>::wls_step(double dt) {
+  auto clock = StageClock::now();
+  auto lap = [&](int stage) {
+    const auto now = StageClock::now();
+    stage_seconds_[stage] += std::chrono::duration<double>(now - clock).count();
+    clock = now;
+  };
+  step_dt_ = dt;
+  wls_->build_stencils(grid_, particles_);
+  lap(0);
+  // Sec. 4.1-4.5: node mass, least-squares velocity (as m v) and forces.
+  compute_body_forces();
+  const bool has_body_force = !body_force_.empty();
+  wls_->collect(grid_, particles_, material_density_, has_body_force ? &body_acceleration_ : nullptr, nodes_,
+                has_body_force ? &node_body_force_ : nullptr);
+  velocity_conditions_.prepare(grid_, nodes_, small_mass_, time_, dt);
+  lap(1);
+  update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)
+  if (config_.method.filter_acceleration) {
+    wls_->filter_acceleration(grid_, nodes_);
+    impose_conditions(nodes_.velocity_new, VelocityConditions<D>::When::end);
+  }
+  lap(2);
+  wls_->move_particles(grid_, nodes_, particles_, dt);  // Eq. 27-29 (or the quadrature gradient)
+  lap(4);
+  // Eq. 30: F <- (I + grad V dt) F, then the material.
+  const auto n = static_cast<std::int64_t>(particles_.n());
+  std::int64_t first_bad = -1;
+  std::string what;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < n; ++p) {
+    Mat3 L = Mat3::Zero();  // the integrator keeps grad V_p (Eq. 29 or the quadrature gradient)
+    L.template topLeftCorner<D, D>() = wls_->particle_velocity_gradient()[p];
+    const Mat3 dF = Mat3::Identity() + L * dt;
+    if (const char* bad = update_particle(static_cast<std::size_t>(p), L, dF, dt)) {
+#pragma omp critical(cairn_failure)
+      if (first_bad < 0 || p < first_bad) {
+        first_bad = p;
+        what = bad;
+      }
+    }
+  }
+  if (first_bad >= 0) particle_failure(first_bad, what);
+  lap(5);
+  velocity_conditions_.finish_step();
+  time_ += dt;
+  ++step_;
 }
 
 template <int D>
@@ -530,31 +653,43 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   });
   if (forces) compute_body_forces();
   const auto& P = particles_;
-  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1).
-  scatter(cache_, [&](std::int32_t p, const auto& stencil) {
-    const std::int32_t off = field_offset(p);
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
-      const std::int32_t i = node + off;
-      const double Sm = S * P.mass[p];
-      if (mass_and_momentum) {
-        nodes_.mass[i] += Sm;
-        if (affine) {
-          const Vec<D> dx = node_offset(grid_, node, P.position[p]);
-          nodes_.momentum[i] += Sm * (P.velocity[p] + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
-        } else {
-          nodes_.momentum[i] += Sm * P.velocity[p];
+  // Tasks 1-2: m = S^T M, p = S^T M V, f = -G^T V0 tau + S^T M b (seed 000 Table 1). The
+  // particle's factors (M, V, -V0 tau) are read once, not once per stencil entry, and the entry
+  // loop is compiled without tests for the plain step (all three sums, no affine part, no body
+  // force).
+  using MatD = Eigen::Matrix<double, D, D>;
+  auto extrapolate = [&](auto plain_tag) {
+    constexpr bool plain = decltype(plain_tag)::value;
+    scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      const double M = P.mass[p];
+      const Vec<D> V = P.velocity[p];
+      const MatD stress = -P.volume0[p] * P.kirchhoff_stress[p].template block<D>();
+      stencil.for_each_force(stress, [&](std::int32_t node, double S, const Vec<D>& force) {
+        const std::int32_t i = node + off;
+        const double Sm = S * M;
+        if (plain || mass_and_momentum) {
+          nodes_.mass[i] += Sm;
+          if (!plain && affine) {
+            const Vec<D> dx = node_offset(grid_, node, P.position[p]);
+            nodes_.momentum[i] += Sm * (V + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+          } else {
+            nodes_.momentum[i] += Sm * V;
+          }
         }
-      }
-      if (forces) {
-        nodes_.force[i] -= P.volume0[p] * P.kirchhoff_stress[p].template times<D>(G);
-        if (has_body_force) {
-          const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
-          nodes_.force[i] += fb;
-          node_body_force_[i] += fb;
+        if (plain || forces) {
+          nodes_.force[i] += force;
+          if (!plain && has_body_force) {
+            const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
+            nodes_.force[i] += fb;
+            node_body_force_[i] += fb;
+          }
         }
-      }
+      });
     });
-  });
+  };
+  if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
+  else extrapolate(std::false_type{});
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
     collectively([&] {
@@ -567,10 +702,13 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
     contact_->prepare(particles_, cache_, nodes_.mass);
     // dv^a is zero wherever this step's first correction does not set it (nodes that were
     // contact nodes last step included).
-    for_each_node(n_slots(), [&](std::int32_t i) { contact_dv_[i].setZero(); });
+    for_each_node(n_slots(), [&](std::int32_t i) {
+      contact_dv_[i].setZero();
+      contact_impulse_[i].setZero();
+    });
     if (contact_->corrects_extrapolation())
       contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, step_dt_,
-                        &contact_dv_);
+                        &contact_dv_, contact_->impulse() ? &contact_impulse_ : nullptr);
     const std::int32_t nn = grid_.n_nodes();
     for_each_node(nn, [&](std::int32_t i) {
       double m = 0.0;
@@ -590,12 +728,16 @@ void Simulation<D>::update_grid(double dt) {
   // Task 3 with the lumped mass: v = m^-1 p, p+ = p + f dt, v+ = m^-1 p+. The staggered central
   // difference start uses half the first acceleration (seed 001 Sec. 4.7, seed 003 Eq. 11-15).
   const double f_scale =
-      (config_.method.time_integration == "central_difference" && step_ == 0) ? 0.5 : 1.0;
+      ((config_.method.time_integration == "central_difference" || wls_) && step_ == 0) ? 0.5 : 1.0;
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (m > small_mass_) {
       nodes_.velocity[i] = nodes_.momentum[i] / m;
       nodes_.velocity_new[i] = (nodes_.momentum[i] + f_scale * nodes_.force[i] * dt) / m;
+    } else if (wls_) {
+      // WLS: the grid velocity is the least-squares fit wherever particles see the node, mass
+      // or not (seed 001 Sec. 4.6); without mass there is no acceleration.
+      nodes_.velocity[i] = nodes_.velocity_new[i] = wls_->node_velocity()[i];
     } else {
       nodes_.velocity[i].setZero();
       nodes_.velocity_new[i].setZero();
@@ -646,9 +788,11 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
   particle_vec_.resize(particles_.n());
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
-    Vec<D> u = Vec<D>::Zero();
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { u += S * in[node + off]; });
-    particle_vec_[p] = u;
+    double u[D] = {};  // registers (see update_stresses)
+    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
+    });
+    particle_vec_[p] = Vec<D>(u);
   });
   refresh_ghosts(particle_vec_);  // the scatter below reads the ghosts' U_p too
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
@@ -729,10 +873,15 @@ void Simulation<D>::subtract_contact_term(std::vector<Vec<D>>& out, int k) {
   // Multimaterial XPIC(k)/FMPM(k): out -= m~_(k-1)^-1 m dv^a, the (I - S S+a)^(k-1) S dv^a term
   // of seed 004 Eq. 37 / 42-44 in the full-mass form of seed 000 Eq. 5: the sum of A^j dv,
   // j = 0 .. k-2, with A = I - S+a S per field.
+  // With first_correction = "impulse" the particles received the contact part dv_c as an
+  // impulse (V' = V + S dv_c), so the extrapolation correction left is v^a - S+a V' =
+  // dv - S+a S dv_c.
   if (k < 2) return;
+  const bool impulse = contact_->impulse() && contact_->corrects_extrapolation();
+  if (impulse) lumped_projection(contact_impulse_, grid_proj_);
   for_each_node(n_slots(), [&](std::int32_t i) {
-    grid_term_[i] = contact_dv_[i];
-    out[i] -= contact_dv_[i];
+    grid_term_[i] = impulse ? Vec<D>(contact_dv_[i] - grid_proj_[i]) : contact_dv_[i];
+    out[i] -= grid_term_[i];
   });
   for (int j = 1; j < k - 1; ++j) {
     lumped_projection(grid_term_, grid_proj_);
@@ -778,7 +927,6 @@ void Simulation<D>::update_particles(double dt) {
   // Task 4 in the unified form (seed 002 Eq. 1.7-1.12): V += A dt, X += VV dt + A dt^2 / 2.
   const UpdateScheme<D>& scheme =
       (scheme_->full_mass() != FullMass::none && !use_full_mass_) ? *flip_ : *scheme_;
-  const bool full = use_full_mass_;
   const bool updated_field = scheme_->full_mass() == FullMass::of_updated;
   const bool affine = scheme.affine();
   const double alpha_g = config_.method.grid_damping, alpha_p = config_.method.particle_damping;
@@ -786,62 +934,76 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_new = nodes_.velocity_new;
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
-  // The sum is the energy dissipated relative to the non-dissipative FLIP update (seed 002
-  // Eq. 1.50).
-  ExactSum dissipated = gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
-    const std::int32_t off = field_offset(p);
-    GridAtParticle<D> g{P.velocity[p], Vec<D>::Zero(), Vec<D>::Zero(), Vec<D>::Zero(), dt};
-    stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-      const std::int32_t i = node + off;
-      g.Sv += S * v[i];
-      g.Sv_new += S * v_new[i];
-      if (full) g.Sv_full += S * v_full[i];
-    });
-    if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
-    Effective<D> e = scheme.effective(g);
-    e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
-    const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
-    // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
-    // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
-    const Vec<D> ag_dt = g.Sv_new - g.Sv;
-    const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
-    const Vec<D> x_old = P.position[p];
-    P.velocity[p] += e.A_dt;
-    P.position[p] += dX;
-    if (affine) {
-      // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
-      // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
-      // for every shape family (D = h^2/4 I for quadratic splines).
-      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+  const bool contact_impulse = contact_ && contact_->impulse() && contact_->corrects_extrapolation();
+  // The sum is the energy dissipated relative to the non-dissipative FLIP update (below). The
+  // entry loop is compiled with and without the full-mass velocity.
+  auto move = [&](auto full_tag) {
+    constexpr bool full = decltype(full_tag)::value;
+    return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
       stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-        const Vec<D> d = node_offset(grid_, node, x_old);
-        B += S * v_new[node + off] * d.transpose();
-        Dp += S * d * d.transpose();
+        const std::int32_t i = node + off;
+        for (int a = 0; a < D; ++a) {
+          sv[a] += S * v[i][a];
+          sv_new[a] += S * v_new[i][a];
+          if (full) sv_full[a] += S * v_full[i][a];
+        }
       });
-      P.affine_velocity[p].setZero();
-      P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
-    }
-    return dissipated;
-  });
+      GridAtParticle<D> g{P.velocity[p], Vec<D>(sv), Vec<D>(sv_new), Vec<D>(sv_full), dt};
+      if (!full) g.Sv_full = updated_field ? g.Sv_new : g.Sv;
+      if (contact_impulse) {
+        // The first correction's contact change is an impulse on the particle (docs/contact.md):
+        // V' = V + S dv_c, and the update proceeds from V'.
+        stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { g.V += S * contact_impulse_[node + off]; });
+      }
+      Effective<D> e = scheme.effective(g);
+      e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
+      const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+      // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
+      // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
+      const Vec<D> ag_dt = g.Sv_new - g.Sv;
+      const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
+      const Vec<D> x_old = P.position[p];
+      P.velocity[p] = g.V + e.A_dt;  // g.V is V, or V' after a contact impulse
+      P.position[p] += dX;
+      if (affine) {
+        // APIC (Jiang et al. 2015): C = B D^-1 with B = sum S v+ (x_i - x_p)^T and
+        // D = sum S (x_i - x_p)(x_i - x_p)^T, which makes the round trip conserve angular momentum
+        // for every shape family (D = h^2/4 I for quadratic splines).
+        Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero(), Dp = B;
+        stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+          const Vec<D> d = node_offset(grid_, node, x_old);
+          B += S * v_new[node + off] * d.transpose();
+          Dp += S * d * d.transpose();
+        });
+        P.affine_velocity[p].setZero();
+        P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
+      }
+      return dissipated;
+    });
+  };
+  ExactSum dissipated = use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
   sum_across(distribution_.comm(), &dissipated, 1);
   dissipated_energy_ += dissipated.value();
 }
 
 template <int D>
-Mat3 Simulation<D>::stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
+void Simulation<D>::update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
   double* state = particles_.n_state_per_particle
                       ? &particles_.state[p * static_cast<std::size_t>(particles_.n_state_per_particle)]
                       : nullptr;
   MaterialPoint point{F, L, state, dt};
   point.dF = &dF;
-  const Mat3 tau_old = particles_.kirchhoff_stress[p];
-  point.tau_old = &tau_old;
+  point.tau_old = &particles_.kirchhoff_stress[p];
   point.cell_size = grid_.min_cell_size();
   point.temperature = particles_.has_temperature ? &particles_.temperature[p] : nullptr;
+  point.planar = D < 3;
   const Material& m = *materials_[particles_.material[p]];
-  if (mode_ == Mode::plane_stress) return plane_stress_update(m, F, point);
-  return m.update(point);
+  SymMat3& tau = particles_.kirchhoff_stress[p];
+  if (mode_ == Mode::plane_stress) tau = plane_stress_update(m, F, point);
+  else m.update_stress(point, tau);
 }
 
 template <int D>
@@ -849,22 +1011,31 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
+  // The kinematics stay in D dimensions: grad V has only its D x D block, so exp(grad V dt) is
+  // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change.
+  using MatD = Eigen::Matrix<double, D, D>;
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
-    Mat3 L = Mat3::Zero();
-    stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) {
-      L.template topLeftCorner<D, D>() += grid_velocity[node + off] * G.transpose();
-    });
+    const MatD L_D = stencil.gradient_of(grid_velocity, off);
+    const MatD dF_D = tensor_exp<D>(L_D * dt);
     Mat3& F = particles_.deformation_gradient[p];
-    const Mat3 dF = tensor_exp(L * dt);
-    F = dF * F;
-    particles_.kirchhoff_stress[p] = stress_for(static_cast<std::size_t>(p), L, dF, dt);
+    F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+    Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
+    L.template topLeftCorner<D, D>() = L_D;
+    dF.template topLeftCorner<D, D>() = dF_D;
+    update_stress_of(static_cast<std::size_t>(p), L, dF, dt);
+    const SymMat3& tau = particles_.kirchhoff_stress[p];
     const double J = F.determinant();
+    // One test for the common case: a sum is finite only if every term is.
     const char* bad = nullptr;
-    if (!particles_.velocity[p].allFinite()) bad = "velocity";
-    else if (!particles_.position[p].allFinite()) bad = "position";
-    else if (!(J > 0.0)) bad = "det F";
-    else if (!particles_.kirchhoff_stress[p].allFinite()) bad = "stress";
+    if (!std::isfinite(particles_.velocity[p].sum() + particles_.position[p].sum() + tau.trace() +
+                       tau(1, 2) + tau(0, 2) + tau(0, 1)) ||
+        !(J > 0.0)) {
+      if (!particles_.velocity[p].allFinite()) bad = "velocity";
+      else if (!particles_.position[p].allFinite()) bad = "position";
+      else if (!(J > 0.0)) bad = "det F";
+      else if (!tau.allFinite()) bad = "stress";
+    }
     if (bad) {
 #pragma omp critical(cairn_failure)
       if (first_bad < 0 || p < first_bad) {
@@ -874,15 +1045,32 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
     }
   });
   collectively([&] {
-    if (first_bad < 0) return;
-    const auto p = static_cast<std::size_t>(first_bad);
-    std::string value;
-    if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
-    else value = what + " is not finite";
-    throw SimulationFailure(first_bad, what,
-                            "particle " + std::to_string(first_bad) + " (body " +
-                                std::to_string(particles_.body[p]) + "): " + value);
+    if (first_bad >= 0) particle_failure(first_bad, what);
   });
+}
+
+template <int D>
+const char* Simulation<D>::update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
+  Mat3& F = particles_.deformation_gradient[p];
+  F = dF * F;
+  update_stress_of(p, L, dF, dt);
+  const double J = F.determinant();
+  if (!particles_.velocity[p].allFinite()) return "velocity";
+  if (!particles_.position[p].allFinite()) return "position";
+  if (!(J > 0.0)) return "det F";
+  if (!particles_.kirchhoff_stress[p].allFinite()) return "stress";
+  return nullptr;
+}
+
+template <int D>
+void Simulation<D>::particle_failure(std::int64_t first_bad, const std::string& what) const {
+  const auto p = static_cast<std::size_t>(first_bad);
+  std::string value;
+  if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
+  else value = what + " is not finite";
+  throw SimulationFailure(first_bad, what,
+                          "particle " + std::to_string(first_bad) + " (body " +
+                              std::to_string(particles_.body[p]) + "): " + value);
 }
 
 template <int D>

@@ -27,6 +27,11 @@
 
 namespace cairn {
 
+namespace wls {
+template <int D>
+class Integrator;
+}
+
 /// Global sums reported in history.csv.
 struct Totals {
   double kinetic_energy = 0.0;
@@ -90,6 +95,8 @@ class Simulation {
   void set_particles(Particles<D> particles);
   /// Node fields; in multimaterial mode field f of node i is entry f * n_nodes + i.
   [[nodiscard]] const NodeField<D>& nodes() const { return nodes_; }
+  /// The WLS method's state (method.integration = "wls", docs/wls.md), or null.
+  [[nodiscard]] const wls::Integrator<D>* wls() const { return wls_.get(); }
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
   /// Node fields summed over the material fields (mass, momentum, velocity_new as m-weighted
@@ -151,12 +158,20 @@ class Simulation {
   /// Particles this rank updates: all local ones outside a step, the owned ones during it.
   [[nodiscard]] std::size_t n_owned() const { return distributed() ? distribution_.n_owned() : particles_.n(); }
   void compute_body_forces();
-  Mat3 stress_for(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// The material's stress update of particle p into its stored stress (plane stress included).
+  void update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
   [[nodiscard]] double max_signal_speed() const;
   /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
   /// with conditions, or m~_k^-1 q for FMPM.
   void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
   void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
+  /// One step of the WLS method (seed 001 Sec. 4): its collection replaces the particle
+  /// transfers; the grid update, conditions and material updates are the engine's.
+  void wls_step(double dt);
+  /// F <- dF F and the material stress of particle p; the failing quantity's name, or null.
+  const char* update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// Throw SimulationFailure for particle p and the quantity update_particle named.
+  [[noreturn]] void particle_failure(std::int64_t p, const std::string& what) const;
   /// Multimaterial XPIC/FMPM: out -= m~_(k-1)^-1 m dv^a (seed 004 Eq. 37, seed 000 Eq. 5).
   void subtract_contact_term(std::vector<Vec<D>>& out, int k);
   /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
@@ -186,6 +201,7 @@ class Simulation {
   std::unique_ptr<UpdateScheme<D>> flip_;
   std::unique_ptr<Conduction<D>> conduction_;  ///< [thermal] conduction = true
   std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
+  std::vector<char> material_in_use_;     ///< whether any particle has material m
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
@@ -205,8 +221,10 @@ class Simulation {
   typename VelocityConditions<D>::When work_when_ = VelocityConditions<D>::When::start;
   double small_mass_ = 0.0;
   std::unique_ptr<Contact<D>> contact_;      ///< multimaterial mode ([contact] mode != none)
+  std::unique_ptr<wls::Integrator<D>> wls_;  ///< method.integration = "wls"
   int n_fields_ = 1;
   std::vector<Vec<D>> contact_dv_;           ///< dv^a of the first correction (slots)
+  std::vector<Vec<D>> contact_impulse_;      ///< its non-bonded part, an impulse on the particles (slots)
   NodeField<D> totals_;                      ///< multimaterial: mass and momentum summed over fields
   std::vector<std::int32_t> field_offset_;   ///< multimaterial: field * n_nodes per particle
   double time_ = 0.0;

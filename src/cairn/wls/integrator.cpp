@@ -1,0 +1,642 @@
+#include "cairn/wls/integrator.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "cairn/transfer/transfer.hpp"
+#include "cairn/util/failure.hpp"
+#include "cairn/wls/least_squares.hpp"
+#include "cairn/wls/weights.hpp"
+
+namespace cairn::wls {
+namespace {
+
+constexpr int pow3(int d) { return d == 0 ? 1 : 3 * pow3(d - 1); }
+
+/// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
+constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
+
+/// Voigt position of stress component (a, b) among the D(D+1)/2 stored ones: diagonal first,
+/// then (in 3D) yz, xz, xy; in 2D xy.
+template <int D>
+constexpr int voigt(int a, int b) {
+  if (a == b) return a;
+  if constexpr (D == 2) {
+    return 2;
+  } else {
+    return 3 + (3 - a - b);  // (1,2) -> 3, (0,2) -> 4, (0,1) -> 5
+  }
+}
+
+/// Narrow shape value and gradient of corner `corner` (bit a: upper node along a) of a cell at the
+/// local coordinates xi in [0, 1]^D: the cell-wise form of seed 001 Eq. 5-6 (a point on a node
+/// takes the cell it lies in, so sum S = 1 and sum G = 0 hold everywhere).
+template <int D>
+void corner_shape(int corner, const Vec<D>& xi, const Vec<D>& inv_h, double& S, Vec<D>& G) {
+  S = 1.0;
+  G.setOnes();
+  for (int a = 0; a < D; ++a) {
+    const bool up = (corner >> a) & 1;
+    const double s = up ? xi[a] : 1.0 - xi[a];
+    const double g = (up ? 1.0 : -1.0) * inv_h[a];
+    S *= s;
+    for (int b = 0; b < D; ++b) G[b] *= (a == b) ? g : s;
+  }
+}
+
+}  // namespace
+
+template <int D>
+Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
+    : options_(options), h_(grid.cell_size()), n_cells_(grid.n_cells()) {
+  const std::int32_t n = grid.n_nodes();
+  moment_.assign(n, {});
+  load_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
+  max_weight_.assign(n, 0.0);
+  count_.assign(n, 0);
+  beta_.assign(n, 0.0);
+  surface_sum_.assign(n, Vec<D>::Zero());
+  surface_weight_.assign(n, 0.0);
+  velocity_.assign(n, Vec<D>::Zero());
+  density_.assign(n, 0.0);
+  force_density_.assign(n, Vec<D>::Zero());
+  stress_.assign(n, Eigen::Matrix<double, D, D>::Zero());
+  inverse_.assign(n, Eigen::Matrix<double, n_basis, n_basis>::Zero());
+  alpha_.assign(n, 0);
+  distance_.assign(n, 0.0);
+  internal_force_.assign(n, Vec<D>::Zero());
+  long long cells = 1;
+  for (int a = 0; a < D; ++a) cells *= n_cells_[a];
+  cell_begin_.assign(static_cast<std::size_t>(cells) + 1, 0);
+}
+
+template <int D>
+void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& particles) {
+  constexpr int slots = pow3(D);
+  const auto n = static_cast<std::int64_t>(particles.n());
+  cache_.reserve(particles.n(), slots);
+  shape_.resize(static_cast<std::size_t>(n) * slots);
+  offset_.resize(static_cast<std::size_t>(n) * slots);
+  const Vec<D> inv_h = h_.cwiseInverse();
+  std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
+#pragma omp parallel
+  {
+    std::int64_t bad_t = std::numeric_limits<std::int64_t>::max();
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
+      const Vec<D> xi = grid.to_cell_units(particles.position[p]);
+      IVec<D> cell;
+      std::array<std::array<double, 3>, D> w{}, s{}, g{}, r{};
+      std::array<std::array<std::int32_t, 3>, D> off{};
+      bool outside = false;
+      for (int a = 0; a < D; ++a) {
+        cell[a] = static_cast<int>(std::floor(xi[a]));
+        outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
+        const int nearest = static_cast<int>(std::floor(xi[a] + 0.5));
+        const double local = xi[a] - cell[a];
+        for (int k = 0; k < 3; ++k) {
+          const int j = nearest - 1 + k;
+          r[a][k] = xi[a] - j;                       // x_p - x_i in cells
+          w[a][k] = wide_weight(r[a][k], 1.0);       // Eq. 4
+          s[a][k] = j == cell[a] ? 1.0 - local : j == cell[a] + 1 ? local : 0.0;  // Eq. 5
+          g[a][k] = j == cell[a] ? -inv_h[a] : j == cell[a] + 1 ? inv_h[a] : 0.0;  // Eq. 6
+          off[a][k] = grid.axis_index(a, j);
+          outside |= off[a][k] < 0;
+        }
+      }
+      cache_.count[p] = static_cast<std::uint16_t>(slots);
+      if (outside) {
+        bad_t = std::min(bad_t, p);
+        continue;
+      }
+      const std::size_t base = static_cast<std::size_t>(p) * slots;
+      std::array<int, D> k{};
+      for (int slot = 0; slot < slots; ++slot) {
+        double W = 1.0, S = 1.0;
+        Vec<D> G = Vec<D>::Ones(), rr;
+        std::int32_t idx = 0;
+        for (int a = 0; a < D; ++a) {
+          W *= w[a][k[a]];
+          S *= s[a][k[a]];
+          for (int b = 0; b < D; ++b) G[b] *= (a == b) ? g[a][k[a]] : s[a][k[a]];
+          rr[a] = r[a][k[a]];
+          idx += off[a][k[a]];
+        }
+        for (int a = 0; a < D; ++a) {
+          if (++k[a] < 3) break;
+          k[a] = 0;
+        }
+        cache_.node[base + slot] = idx;
+        cache_.weight[base + slot] = W;
+        cache_.gradient[base + slot] = G;
+        shape_[base + slot] = S;
+        offset_[base + slot] = rr;
+      }
+    }
+#pragma omp critical(cairn_wls_stencil)
+    first_bad = std::min(first_bad, bad_t);
+  }
+  if (first_bad != std::numeric_limits<std::int64_t>::max()) {
+    const Vec<D>& x = particles.position[first_bad];
+    std::string where;
+    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + std::to_string(x[a]);
+    throw SimulationFailure(first_bad, "position",
+                            "particle " + std::to_string(first_bad) + " left the grid at (" + where +
+                                "): WLS integrates over the grid's cells only");
+  }
+  cache_.reach_lo = IVec<D>::Ones();
+  cache_.reach_hi = IVec<D>::Ones();
+  colour_blocks(grid, particles, cache_);  // blocks by the cell holding each particle
+}
+
+template <int D>
+void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
+                            const std::vector<double>& density0, const std::vector<Vec<D>>* body_acceleration,
+                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force) {
+  const auto n = static_cast<std::int64_t>(particles.n());
+  const bool body_force = body_acceleration != nullptr;
+  const int n_used = body_force ? n_fields : n_fields - D;
+  // Sec. 4.1: J_p, rho_p = rho0 / J_p, sigma_p = tau_p / J_p, f_p = rho_p b_p.
+  particle_fields_.resize(static_cast<std::size_t>(n) * n_fields);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < n; ++p) {
+    double* f = &particle_fields_[static_cast<std::size_t>(p) * n_fields];
+    const double J = particles.deformation_gradient[p].determinant();
+    const double rho = density0[particles.material[p]] / J;
+    for (int a = 0; a < D; ++a) f[a] = particles.velocity[p][a];
+    f[D] = rho;
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b) f[D + 1 + voigt<D>(a, b)] = particles.kirchhoff_stress[p](a, b) / J;
+    if (body_force)
+      for (int a = 0; a < D; ++a) f[D + 1 + n_stress + a] = rho * (*body_acceleration)[p][a];
+  }
+  const std::int32_t n_nodes = grid.n_nodes();
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    moment_[i].fill(0.0);
+    std::fill_n(&load_[static_cast<std::size_t>(i) * n_fields * n_basis], n_fields * n_basis, 0.0);
+    max_weight_[i] = 0.0;
+    count_[i] = 0;
+    beta_[i] = 0.0;
+    surface_sum_[i].setZero();
+    surface_weight_[i] = 0.0;
+  });
+  // Moment matrices and load vectors (Eq. 9) with the wide weight; particle flags (Eq. 13) and
+  // surface positions (Eq. 15) with the narrow shape.
+  auto entry = [&](std::int32_t p, std::size_t s) {
+    const std::int32_t i = cache_.node[s];
+    const double S = shape_[s];
+    if (S != 0.0) {
+      const bool surface = is_surface(particles, static_cast<std::size_t>(p));
+      beta_[i] += S * (surface ? 1.0 : 2.0);
+      if (surface) {
+        surface_sum_[i] += S * particles.position[p];
+        surface_weight_[i] += S;
+      }
+    }
+    const double W = cache_.weight[s];
+    if (W <= 0.0) return;
+    const auto b = PlaneFit<D>::basis(offset_[s]);
+    auto& M = moment_[i];
+    for (int r = 0; r < n_basis; ++r)
+      for (int c = r; c < n_basis; ++c) M[packed(r, c, n_basis)] += W * b[r] * b[c];
+    const double* f = &particle_fields_[static_cast<std::size_t>(p) * n_fields];
+    double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
+    for (int k = 0; k < n_used; ++k) {
+      const double wf = W * f[k];
+      for (int r = 0; r < n_basis; ++r) l[k * n_basis + r] += wf * b[r];
+    }
+    max_weight_[i] = std::max(max_weight_[i], W);
+    ++count_[i];
+  };
+  // The list-layout cache holds all 3^D slots of every particle; shape_ and offset_ share its
+  // slot numbering.
+  constexpr int slots = pow3(D);
+  scatter(cache_, [&](std::int32_t p, const auto&) {
+    const std::size_t base = static_cast<std::size_t>(p) * slots;
+    for (std::size_t s = base; s < base + slots; ++s) entry(p, s);
+  });
+  fit_nodes(grid, n_used);
+  refine_distance(grid);
+  build_regions(grid);
+  integrate(grid, body_force, nodes, node_body_force);
+}
+
+template <int D>
+void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
+  const std::int32_t n_nodes = grid.n_nodes();
+  const double h = grid.min_cell_size();
+  std::vector<long long> spurious(static_cast<std::size_t>(omp_get_max_threads()), 0);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    // Flags summed over the mirror images across symmetry planes the node lies on (a node on
+    // such a plane sees the same particles again on the other side).
+    const IVec<D> j = grid.multi_index(i);
+    bool on_symmetry[D];
+    double mirror = 1.0;
+    for (int a = 0; a < D; ++a) {
+      on_symmetry[a] = (j[a] == 0 && options_.mirror[2 * a]) || (j[a] == n_cells_[a] && options_.mirror[2 * a + 1]);
+      if (on_symmetry[a]) mirror *= 2.0;
+    }
+    beta_[i] *= mirror;
+    distance_[i] = beta_[i] > 2.0 ? h : -h;  // first estimate, Eq. 14
+    if (surface_weight_[i] > 0.0) {
+      surface_sum_[i] /= surface_weight_[i];  // x_i^surf, Eq. 15
+      const Vec<D> xi = grid.node_position(i);
+      for (int a = 0; a < D; ++a)
+        if (on_symmetry[a]) surface_sum_[i][a] = xi[a];
+    }
+    velocity_[i].setZero();
+    density_[i] = 0.0;
+    force_density_[i].setZero();
+    stress_[i].setZero();
+    inverse_[i].setZero();
+    alpha_[i] = 0;
+    if (count_[i] == 0) return;
+    Eigen::Matrix<double, n_basis, n_basis> M;
+    for (int r = 0; r < n_basis; ++r)
+      for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = moment_[i][packed(r, c, n_basis)];
+    // Sec. 3.5: too few particles, or none above the trigger weight: constant fit only.
+    const bool reduce = count_[i] < D + 1 || max_weight_[i] < options_.trigger_weight;
+    bool reduced = true;
+    inverse_[i] = PlaneFit<D>::inverse(M, reduce, &reduced);
+    alpha_[i] = reduced ? 0 : 1;
+    if (reduced) ++spurious[static_cast<std::size_t>(omp_get_thread_num())];
+    const double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
+    auto value = [&](int k) {  // c0 of field k (Eq. 10-11)
+      double c0 = 0.0;
+      for (int r = 0; r < n_basis; ++r) c0 += inverse_[i](0, r) * l[k * n_basis + r];
+      return c0;
+    };
+    for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
+    density_[i] = value(D);
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b) stress_[i](a, b) = stress_[i](b, a) = value(D + 1 + voigt<D>(a, b));
+    if (n_used == n_fields)
+      for (int a = 0; a < D; ++a) force_density_[i][a] = value(D + 1 + n_stress + a);
+  });
+  n_spurious_ = 0;
+  for (long long s : spurious) n_spurious_ += s;
+}
+
+template <int D>
+Eigen::Matrix<double, D, D> Integrator<D>::velocity_gradient_fit(std::int32_t i) const {
+  Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+  const double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) {
+      double c = 0.0;
+      for (int r = 0; r < n_basis; ++r) c += inverse_[i](1 + b, r) * l[a * n_basis + r];
+      L(a, b) = c / h_[b];  // Eq. 12, back from cell units
+    }
+  return L;
+}
+
+template <int D>
+void Integrator<D>::refine_distance(const Grid<D>& grid) {
+  // Sec. 3.3, second stage: nodes with surface particles in their narrow support.
+  const std::int32_t n_nodes = grid.n_nodes();
+  const Vec<D> inv_h = h_.cwiseInverse();
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    if (surface_weight_[i] <= 0.0) return;
+    const Vec<D>& xs = surface_sum_[i];
+    // Normal: gradient of the flag field at x_surf (Eq. 16), from the corners of its cell.
+    const Vec<D> u = grid.to_cell_units(xs);
+    IVec<D> cell;
+    Vec<D> local;
+    for (int a = 0; a < D; ++a) {
+      cell[a] = static_cast<int>(std::floor(u[a]));
+      local[a] = u[a] - cell[a];
+    }
+    Vec<D> normal = Vec<D>::Zero();
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      IVec<D> j = cell;
+      for (int a = 0; a < D; ++a) j[a] += (corner >> a) & 1;
+      const std::int32_t node = grid.node_index(j);
+      if (node < 0) continue;
+      double S;
+      Vec<D> G;
+      corner_shape<D>(corner, local, inv_h, S, G);
+      normal += G * beta_[node];
+    }
+    const Vec<D> dv = xs - grid.node_position(i);
+    const double along = dv.dot(normal);
+    if (options_.projected_distance) {
+      const double norm = normal.norm();
+      if (norm > 0.0) distance_[i] = -along / norm;
+    } else {
+      distance_[i] = -(along < 0.0 ? -1.0 : 1.0) * dv.norm();  // Eq. 17
+    }
+  });
+}
+
+template <int D>
+void Integrator<D>::build_regions(const Grid<D>& grid) {
+  if constexpr (D == 1) {
+    (void)grid;
+  } else {
+    const auto n_cells_total = static_cast<std::int64_t>(cell_begin_.size()) - 1;
+    auto cell_index = [&](std::int64_t c) {
+      IVec<D> j;
+      for (int a = 0; a < D; ++a) {
+        j[a] = static_cast<int>(c % n_cells_[a]);
+        c /= n_cells_[a];
+      }
+      return j;
+    };
+    // The inside regions of cell c from the distances at its corners (nodes, lower corner lo).
+    auto cut = [&](std::int64_t c, std::array<std::int32_t, (1 << D)>& node, Vec<D>& lo,
+                   std::array<CellRegion<D>, max_regions<D>>& out) {
+      const IVec<D> cell = cell_index(c);
+      std::array<double, (1 << D)> d;
+      for (int k = 0; k < (1 << D); ++k) {
+        IVec<D> j = cell;
+        for (int a = 0; a < D; ++a) j[a] += (k >> a) & 1;
+        node[k] = grid.node_index(j);
+        d[k] = distance_[node[k]];
+      }
+      lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
+      return cut_cell<D>(d, lo, h_, out);
+    };
+    // Pass 1: regions per cell; pass 2 (after the prefix sum) the regions themselves.
+    std::vector<std::int32_t>& begin = cell_begin_;
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < n_cells_total; ++c) {
+      std::array<std::int32_t, (1 << D)> node;
+      std::array<CellRegion<D>, max_regions<D>> out;
+      Vec<D> lo;
+      begin[c + 1] = cut(c, node, lo, out);
+    }
+    begin[0] = 0;
+    for (std::int64_t c = 0; c < n_cells_total; ++c) begin[c + 1] += begin[c];
+    regions_.resize(static_cast<std::size_t>(begin[n_cells_total]));
+    const double thickness = D == 2 ? options_.thickness : 1.0;
+    const Vec<D> inv_h = h_.cwiseInverse();
+#pragma omp parallel for schedule(static)
+    for (std::int64_t c = 0; c < n_cells_total; ++c) {
+      if (begin[c + 1] == begin[c]) continue;
+      std::array<std::int32_t, (1 << D)> node;
+      std::array<CellRegion<D>, max_regions<D>> out;
+      Vec<D> lo;
+      const int n = cut(c, node, lo, out);
+      for (int r = 0; r < n; ++r) {
+        Region<D>& q = regions_[begin[c] + r];
+        q.cell = static_cast<std::int32_t>(c);
+        q.volume = out[r].volume * thickness;
+        q.centroid = out[r].centroid;
+        // Eq. 19-21: values at the point from the well-conditioned corners (alpha_i = 1); a
+        // cell whose corners are all spurious falls back to all of them.
+        const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+        for (int pass = 0; pass < 2; ++pass) {
+          double sum = 0.0;
+          q.density = 0.0;
+          q.force_density.setZero();
+          q.stress.setZero();
+          for (int k = 0; k < (1 << D); ++k) {
+            if (pass == 0 && !alpha_[node[k]]) continue;
+            double S;
+            Vec<D> G;
+            corner_shape<D>(k, local, inv_h, S, G);
+            sum += S;
+            q.density += S * density_[node[k]];
+            q.force_density += S * force_density_[node[k]];
+            q.stress += S * stress_[node[k]];
+          }
+          if (sum > 0.0) {
+            q.density /= sum;
+            q.force_density /= sum;
+            q.stress /= sum;
+            break;
+          }
+        }
+      }
+    }
+  }
+}
+
+template <int D>
+template <class Fn>
+void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const {
+  const Vec<D> inv_h = h_.cwiseInverse();
+  const IVec<D> j = grid.multi_index(i);
+  for (int k = 0; k < (1 << D); ++k) {  // node i is corner k of the cell j - bits(k)
+    IVec<D> cell = j;
+    bool inside = true;
+    for (int a = 0; a < D; ++a) {
+      cell[a] -= (k >> a) & 1;
+      inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
+    }
+    if (!inside) continue;
+    std::int64_t c = 0;
+    for (int a = D - 1; a >= 0; --a) c = c * n_cells_[a] + cell[a];
+    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
+    for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) {
+      double S;
+      Vec<D> G;
+      corner_shape<D>(k, (regions_[r].centroid - lo).cwiseProduct(inv_h), inv_h, S, G);
+      fn(r, regions_[r], S, G);
+    }
+  }
+}
+
+template <int D>
+void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
+                              std::vector<Vec<D>>* node_body_force) {
+  const std::int32_t n_nodes = grid.n_nodes();
+  // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    double m = 0.0;
+    Vec<D> fe = Vec<D>::Zero(), fi = Vec<D>::Zero();
+    for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>& G) {
+      m += S * q.density * q.volume;         // Eq. 22
+      fe += S * q.volume * q.force_density;  // Eq. 23
+      fi -= q.volume * (q.stress * G);       // Eq. 24 (with sigma_q; Eq. 3's sign)
+    });
+    nodes.mass[i] = m;
+    nodes.momentum[i] = m * velocity_[i];
+    internal_force_[i] = fi;
+    nodes.force[i] = fe;
+    if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
+    if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
+  });
+  // Sec. 3.5 / 4.5: the internal force of a spurious node is the mean over its 3^D - 1
+  // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    Vec<D> fi = internal_force_[i];
+    if (!alpha_[i] && nodes.mass[i] > 0.0) {
+      const IVec<D> j = grid.multi_index(i);
+      Vec<D> sum = Vec<D>::Zero();
+      int n = 0;
+      std::array<int, D> k{};
+      for (int s = 0; s < pow3(D); ++s) {
+        IVec<D> jn = j;
+        bool self = true;
+        for (int a = 0; a < D; ++a) {
+          jn[a] += k[a] - 1;
+          self &= k[a] == 1;
+        }
+        for (int a = 0; a < D; ++a) {
+          if (++k[a] < 3) break;
+          k[a] = 0;
+        }
+        if (self) continue;
+        const std::int32_t nb = grid.node_index(jn);
+        if (nb < 0 || !alpha_[nb] || !(nodes.mass[nb] > 0.0)) continue;
+        sum += options_.average_per_mass ? Vec<D>(internal_force_[nb] / nodes.mass[nb]) : internal_force_[nb];
+        ++n;
+      }
+      fi = n == 0 ? Vec<D>::Zero() : Vec<D>(sum / n);
+      if (options_.average_per_mass) fi *= nodes.mass[i];
+    }
+    nodes.force[i] += fi;
+  });
+}
+
+template <int D>
+void Integrator<D>::filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes) {
+  // dv_i = v+_i - v_i = a_i dt replaced by the planar least-squares fit (Eq. 7-12 on the grid)
+  // over the node and its 3^D - 1 neighbours that carry mass, weighted by W(x_j - x_i) m_j:
+  // linear acceleration fields pass unchanged, the node-to-node zig-zag a single node's small
+  // cut-cell mass and force produce does not (docs/wls.md).
+  const std::int32_t n_nodes = grid.n_nodes();
+  filtered_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    filtered_[i] = nodes.velocity_new[i] - nodes.velocity[i];
+    if (!(nodes.mass[i] > 0.0)) return;
+    const IVec<D> j = grid.multi_index(i);
+    typename PlaneFit<D>::Matrix M = PlaneFit<D>::Matrix::Zero();
+    Eigen::Matrix<double, n_basis, D> load = Eigen::Matrix<double, n_basis, D>::Zero();
+    std::array<int, D> k{};
+    for (int s = 0; s < pow3(D); ++s) {
+      IVec<D> jn = j;
+      Vec<D> r;
+      double w = 1.0;
+      for (int a = 0; a < D; ++a) {
+        jn[a] += k[a] - 1;
+        r[a] = k[a] - 1;
+        w *= wide_weight(r[a], 1.0);
+      }
+      for (int a = 0; a < D; ++a) {
+        if (++k[a] < 3) break;
+        k[a] = 0;
+      }
+      const std::int32_t nb = grid.node_index(jn);
+      if (nb < 0 || !(nodes.mass[nb] > 0.0)) continue;
+      w *= nodes.mass[nb];
+      const auto b = PlaneFit<D>::basis(r);
+      M += w * b * b.transpose();
+      load += w * b * (nodes.velocity_new[nb] - nodes.velocity[nb]).transpose();
+    }
+    const auto inverse = PlaneFit<D>::inverse(M, false);
+    filtered_[i] = (inverse.row(0) * load).transpose();
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) { nodes.velocity_new[i] = nodes.velocity[i] + filtered_[i]; });
+}
+
+template <int D>
+void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
+  // (the strain rate the internal force of Eq. 24 is the power conjugate of) ...
+  const auto n_regions = static_cast<std::int64_t>(regions_.size());
+  region_gradient_.resize(regions_.size());
+  const Vec<D> inv_h = h_.cwiseInverse();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t r = 0; r < n_regions; ++r) {
+    const Region<D>& q = regions_[r];
+    IVec<D> cell;
+    std::int64_t c = q.cell;
+    for (int a = 0; a < D; ++a) {
+      cell[a] = static_cast<int>(c % n_cells_[a]);
+      c /= n_cells_[a];
+    }
+    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
+    const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) {
+      IVec<D> j = cell;
+      for (int a = 0; a < D; ++a) j[a] += (k >> a) & 1;
+      double S;
+      Vec<D> G;
+      corner_shape<D>(k, local, inv_h, S, G);
+      L += v_new[grid.node_index(j)] * G.transpose();
+    }
+    region_gradient_[r] = L;
+  }
+  // ... and its S V-weighted mean over the integration points around each node.
+  const std::int32_t n_nodes = grid.n_nodes();
+  node_gradient_.resize(n_nodes);
+  node_gradient_weight_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    Eigen::Matrix<double, D, D> sum = Eigen::Matrix<double, D, D>::Zero();
+    double weight = 0.0;
+    for_each_region_of_node(grid, i, [&](std::int32_t r, const Region<D>& q, double S, const Vec<D>&) {
+      sum += S * q.volume * region_gradient_[r];
+      weight += S * q.volume;
+    });
+    node_gradient_[i] = weight > 0.0 ? Eigen::Matrix<double, D, D>(sum / weight) : sum;
+    node_gradient_weight_[i] = weight;
+  });
+}
+
+template <int D>
+void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles,
+                                   double dt) {
+  const auto& v = nodes.velocity;
+  const auto& v_new = nodes.velocity_new;
+  const bool from_quadrature = options_.quadrature_gradient;
+  if (from_quadrature) quadrature_gradients(grid, v_new);
+  constexpr int slots = pow3(D);
+  particle_gradient_.resize(particles.n());
+  gather(cache_, [&](std::int64_t p, const auto&) {
+    const std::size_t begin = static_cast<std::size_t>(p) * slots, end = begin + slots;
+    Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    double weight = 0.0;
+    for (std::size_t s = begin; s < end; ++s) {
+      const std::int32_t i = cache_.node[s];
+      const double S = shape_[s];
+      dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
+      vx += S * v_new[i];           // Eq. 28
+      if (!from_quadrature) {
+        L += v_new[i] * cache_.gradient[s].transpose();  // Eq. 29
+      } else if (node_gradient_weight_[i] > 0.0) {
+        // S-interpolated node means of the integration points' gradients (docs/wls.md), over
+        // the nodes that have integration points around them.
+        L += S * node_gradient_[i];
+        weight += S;
+      }
+    }
+    if (from_quadrature && weight > 0.0) L /= weight;
+    particles.velocity[p] += dv;
+    particles.position[p] += vx * dt;
+    particle_gradient_[p] = L;
+  });
+}
+
+template <int D>
+Particles<D> region_points(const Integrator<D>& integrator) {
+  Particles<D> out;
+  const auto& regions = integrator.regions();
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    const Region<D>& q = regions[r];
+    const int within = (r > 0 && regions[r - 1].cell == q.cell) ? out.material.back() + 1 : 0;
+    out.add(q.centroid, Vec<D>::Zero(), q.density * q.volume, q.volume, Vec<D>::Zero(), within, q.cell);
+    Mat3 tau = Mat3::Zero();
+    tau.template topLeftCorner<D, D>() = q.stress;
+    out.kirchhoff_stress.back() = tau;
+  }
+  return out;
+}
+
+template Particles<1> region_points<1>(const Integrator<1>&);
+template Particles<2> region_points<2>(const Integrator<2>&);
+template Particles<3> region_points<3>(const Integrator<3>&);
+
+template class Integrator<1>;
+template class Integrator<2>;
+template class Integrator<3>;
+
+}  // namespace cairn::wls

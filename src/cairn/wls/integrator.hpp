@@ -1,0 +1,172 @@
+// The weighted-least-squares particle-in-cell method of seed 001 (Wallstedt & Guilkey) as a
+// method of Cairn's one engine: Simulation<D> owns an Integrator when method.integration = "wls"
+// and runs its stages in place of the particle-integrated transfers (docs/wls.md):
+//
+//   build_stencils    W (wide, Eq. 4) and S, G (narrow, Eq. 5-6) of every particle; colouring
+//   collect           Sec. 4.1-4.5: particle density, body-force density and Cauchy stress;
+//                     node moment matrices and least-squares values (Eq. 7-12); surface flags
+//                     and signed distance on the nodes (Eq. 13-17); cut cells with one centroid
+//                     point per inside region (Eq. 18, Sec. 3.4); quadrature values (Eq. 19-21);
+//                     node mass, external and internal force (Eq. 22-24); averaged internal force
+//                     at spurious nodes (Sec. 3.5, 4.5). Results go into the engine's NodeField:
+//                     mass m_i, momentum m_i v_i (so that m^-1 p is the least-squares velocity,
+//                     Sec. 4.6) and force f_int + f_ext.
+//   (the engine)      v+ = v + a dt with velocity conditions, half the first acceleration
+//                     (Eq. 25-26, Sec. 4.7)
+//   move_particles    Eq. 27-29: V += S a dt, x += S v+ dt, grad V = sum v+ (x) G
+//   (the engine)      Eq. 30: F += grad V F dt, stress from the material
+//
+// Surface particles are the particles with zero initial volume (wls/arrangement.hpp).
+// Everything the method keeps between stages lives here; nothing is kept between steps except
+// what the particles carry, so checkpoints and restarts need nothing extra.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/transfer/cache.hpp"
+#include "cairn/wls/cut_cell.hpp"
+
+namespace cairn::wls {
+
+/// Surface particle (beta_p = 1, seed 001 Eq. 13): a sample point of zero initial volume.
+template <int D>
+inline bool is_surface(const Particles<D>& particles, std::size_t p) {
+  return particles.volume0[p] == 0.0;
+}
+
+struct Options {
+  double trigger_weight = 0.12;  ///< TW of Sec. 3.5
+  /// Signed distance of a near-surface node: true = projection of x_surf - x_i on the unit
+  /// normal (the text of Sec. 3.3, step 2); false = |x_surf - x_i| with the sign (Eq. 17 as printed).
+  bool projected_distance = false;
+  /// Spurious-node internal force (Sec. 3.5, 4.5): true = mean of the neighbours' internal
+  /// force per unit mass, times the node's mass; false = mean of the neighbours' internal force.
+  bool average_per_mass = true;
+  /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches): node
+  /// flags count the mirror image and surface positions of nodes on it lie in it.
+  std::array<bool, 6> mirror{};
+  /// Particle velocity gradient: true = from the integration points (sum_k v+_k (x) G_kq at each
+  /// region, S V-averaged to the nodes, S-interpolated to the particle; docs/wls.md); false =
+  /// Eq. 29 as printed (sum_i v+_i (x) G_ip), unstable at free surfaces in our runs.
+  bool quadrature_gradient = true;
+  double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
+};
+
+/// One integration region: the inside part of a cut or full cell (Sec. 3.4) and its values.
+template <int D>
+struct Region {
+  std::int32_t cell = 0;  ///< linear cell index (x fastest) of the cell holding it
+  double volume = 0.0;    ///< V_q (times the thickness in 2D)
+  Vec<D> centroid = Vec<D>::Zero();
+  double density = 0.0;   ///< rho_q (Eq. 19)
+  Vec<D> force_density = Vec<D>::Zero();  ///< f_q^ext (Eq. 20)
+  Eigen::Matrix<double, D, D> stress = Eigen::Matrix<double, D, D>::Zero();  ///< sigma_q (Eq. 21)
+};
+
+template <int D>
+class Integrator {
+ public:
+  Integrator(const Grid<D>& grid, const Options& options);
+
+  /// W, S and G of every particle over the 3^D nodes around its nearest node, and the
+  /// colouring of the scatter. Throws SimulationFailure when a particle left the grid.
+  void build_stencils(const Grid<D>& grid, const Particles<D>& particles);
+
+  /// Sec. 4.1-4.5 into `nodes` (mass, momentum, force; velocities and reactions cleared) and,
+  /// when given, the external part of the force into `node_body_force`. `density0[m]` is the
+  /// reference density of material m; `body_acceleration` (b_p, or null) the body force.
+  void collect(const Grid<D>& grid, const Particles<D>& particles, const std::vector<double>& density0,
+               const std::vector<Vec<D>>* body_acceleration, NodeField<D>& nodes,
+               std::vector<Vec<D>>* node_body_force);
+
+  /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
+  /// x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
+  /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
+  /// integration points' gradients.
+  void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);
+
+  /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
+  /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.
+  void filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes);
+
+  // ---- inspection (tests, snapshots) ----------------------------------------------------------
+  [[nodiscard]] const std::vector<double>& signed_distance() const { return distance_; }
+  /// 1 where the node's least-squares fit is well conditioned (alpha_i of Eq. 19-21).
+  [[nodiscard]] const std::vector<std::uint8_t>& well_conditioned() const { return alpha_; }
+  /// Nodes that had particles in their support but were reduced to the constant fit.
+  [[nodiscard]] long long spurious_nodes() const { return n_spurious_; }
+  [[nodiscard]] const std::vector<Region<D>>& regions() const { return regions_; }
+  /// Least-squares node values of the last collect (Eq. 11): velocity, density, stress.
+  [[nodiscard]] const std::vector<Vec<D>>& node_velocity() const { return velocity_; }
+  [[nodiscard]] const std::vector<double>& node_density() const { return density_; }
+  [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& node_stress() const { return stress_; }
+  /// beta_i of Eq. 13 (with the mirror images across symmetry planes).
+  [[nodiscard]] const std::vector<double>& node_flags() const { return beta_; }
+  /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced.
+  [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
+  /// grad V_p of every particle from the last move_particles (the F and stress update's L).
+  [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
+    return particle_gradient_;
+  }
+
+ private:
+  static constexpr int n_basis = D + 1;
+  static constexpr int n_moment = (D + 1) * (D + 2) / 2;
+  static constexpr int n_stress = D * (D + 1) / 2;
+  /// Fields fitted per node: velocity (D), density (1), stress (D(D+1)/2), body-force density (D).
+  static constexpr int n_fields = 2 * D + 1 + n_stress;
+
+  void fit_nodes(const Grid<D>& grid, int n_used_fields);
+  void refine_distance(const Grid<D>& grid);
+  void build_regions(const Grid<D>& grid);
+  void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force);
+  /// fn(region index, region, S_iq, G_iq) for every region in the cells node i is a corner of.
+  template <class Fn>
+  void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;
+  void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
+
+  Options options_;
+  Vec<D> h_;
+  IVec<D> n_cells_;
+  TransferCache<D> cache_;             ///< node, weight = W, gradient = G per stencil slot
+  std::vector<double> shape_;          ///< S per stencil slot
+  std::vector<Vec<D>> offset_;         ///< x_p - x_i in cells per stencil slot
+  std::vector<double> particle_fields_;///< n x n_fields per-particle values of the step
+  // node accumulators and results
+  std::vector<std::array<double, n_moment>> moment_;
+  std::vector<double> load_;           ///< n_nodes x n_fields x n_basis
+  std::vector<double> max_weight_;
+  std::vector<std::int32_t> count_;
+  std::vector<double> beta_;
+  std::vector<Vec<D>> surface_sum_;    ///< sum S x over surface particles
+  std::vector<double> surface_weight_; ///< sum S over surface particles
+  std::vector<Vec<D>> velocity_;
+  std::vector<double> density_;
+  std::vector<Vec<D>> force_density_;
+  std::vector<Eigen::Matrix<double, D, D>> stress_;
+  std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
+  std::vector<std::uint8_t> alpha_;
+  std::vector<double> distance_;
+  std::vector<Vec<D>> internal_force_;
+  long long n_spurious_ = 0;
+  // cells
+  std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_
+  std::vector<Region<D>> regions_;
+  std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
+  std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
+  std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
+  std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)
+  std::vector<Vec<D>> filtered_;                              ///< scratch of filter_acceleration
+};
+
+/// The integration regions as points for a snapshot (ParaView): position = centroid, volume0 =
+/// V_q, mass = rho_q V_q, Cauchy stress sigma_q (F = I, so it is also the "Kirchhoff" stress),
+/// body = linear cell index, material = number of the region within its cell.
+template <int D>
+Particles<D> region_points(const Integrator<D>& integrator);
+
+}  // namespace cairn::wls
