@@ -58,6 +58,9 @@ void print_summary(const cairn::RunSummary& s) {
              "{} {}s)\n",
              s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, omp_get_max_threads(),
              s.n_particles, s.item);
+  if (s.adaptive_threads)
+    fmt::print("cairn: adaptive threads: {} of {} steps on 1 thread (simulation.adapt_threads)\n",
+               s.single_thread_steps, s.steps);
   fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;

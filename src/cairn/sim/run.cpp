@@ -23,6 +23,7 @@
 #include "cairn/io/snapshot.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/sim/thread_tuner.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/integrator.hpp"
 
@@ -212,13 +213,17 @@ class Runner {
       write_snapshot();
     }
     bool wrote_history = true, wrote_snapshot = true;
+    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads);
     while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
+      tuner.before_step();
+      const auto step_start = Clock::now();
       const double dt = sim_.next_dt();
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
         fail(f, dt);
       }
+      tuner.after_step(std::chrono::duration<double>(Clock::now() - step_start).count());
       last_dt_ = dt;
       measure_error();
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
@@ -247,6 +252,7 @@ class Runner {
       if (stop_signal != 0) interrupted(static_cast<int>(stop_signal));
       progress(start, first_step);
     }
+    tuner.finish();
     if (!wrote_history) write_history_row();
     if (!wrote_snapshot) write_snapshot();
     history_writer_.flush();
@@ -264,6 +270,8 @@ class Runner {
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
     summary.stage_seconds = sim_.stage_times();
+    summary.adaptive_threads = tuner.enabled();
+    summary.single_thread_steps = tuner.single_thread_steps();
     if (const auto* c = sim_.contact()) {
       summary.contact_prepare_seconds = c->prepare_seconds();
       summary.contact_fit_seconds = c->fit_seconds();
