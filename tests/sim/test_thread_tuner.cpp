@@ -49,6 +49,12 @@ TEST(ThreadTuner, FollowsAChangeOfLoad) {
   EXPECT_EQ(tuner.threads(), 1);
 }
 
+TEST(ThreadTuner, LongStepsKeepTheTeamWithoutProbes) {
+  ThreadTuner tuner(2, true);
+  EXPECT_EQ(drive(tuner, 3000, 2.0 * ThreadTuner::long_step, 1.5 * ThreadTuner::long_step), 0);
+  EXPECT_EQ(tuner.threads(), 2);
+}
+
 TEST(ThreadTuner, OffForOneThreadOrWhenDisabled) {
   ThreadTuner one(1, true), off(4, false);
   EXPECT_FALSE(one.enabled());

@@ -23,6 +23,9 @@ class ThreadTuner {
   /// timed at the end of a hold and of a probe, and the hold lengths.
   static constexpr int warm_steps = 1, timed_steps = 2;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
+  /// A step of the full team that takes longer than this is not probed with one thread: its
+  /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
+  static constexpr double long_step = 0.02;
 
   /// max_threads: the team size the run was given; tuning is off for 1 thread or !enabled.
   ThreadTuner(int max_threads, bool enabled) : max_(max_threads), enabled_(enabled && max_threads > 1) {
@@ -56,6 +59,10 @@ class ThreadTuner {
     if (!probing_) {
       // End of a hold: time per step of the choice, then a probe of the other count.
       chosen_time_ = per_step;
+      if (chosen_ == max_ && per_step > long_step) {
+        hold_ = longest_hold;
+        return;
+      }
       current_ = chosen_ == 1 ? max_ : 1;
       probing_ = true;
       return;
