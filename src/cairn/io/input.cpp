@@ -902,6 +902,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.adapt_threads = r.boolean("adapt_threads");
   s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
+  s.rebalance_threshold = r.real("rebalance_threshold");
   s.max_estimated_steps = r.real("max_estimated_steps");
   s.body_overlap = r.string("body_overlap");
   s.where = locate(r.path_of("end_time"), r.given("end_time") ? r.given("end_time") : section(root, "simulation"));
@@ -1711,6 +1712,7 @@ std::string config_to_toml(const Config& c) {
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
   line("adapt_threads", s.adapt_threads ? "true" : "false");
+  line("rebalance_threshold", real_text(s.rebalance_threshold));
   line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));
   line("max_estimated_steps", real_text(s.max_estimated_steps));
