@@ -21,9 +21,11 @@
 #include "cairn/io/errors.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
+#include "cairn/io/output_schedule.hpp"
 #include "cairn/io/snapshot.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/sim/thread_tuner.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/integrator.hpp"
 
@@ -122,18 +124,6 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
   return columns;
 }
 
-/// Output schedule as integer counters so that output times do not drift with round-off.
-struct Schedule {
-  double interval = 0.0;
-  long long done = 0;  ///< outputs written at t > 0
-  [[nodiscard]] bool due(double t) const {
-    return interval > 0.0 && t >= static_cast<double>(done + 1) * interval * (1.0 - 1e-12);
-  }
-  void advance(double t) {
-    while (due(t)) ++done;
-  }
-};
-
 template <int D>
 class Runner {
  public:
@@ -144,12 +134,9 @@ class Runner {
         comm_(sim_.comm()),
         dir_(config.output.directory),
         meta_(output_metadata(config)),
+        schedule_(config.output, config.simulation.end_time),
         snapshots_(dir_, "particles", meta_, comm_) {
     const auto& out = config_.output;
-    const double end = config_.simulation.end_time;
-    snapshot_.interval = out.every;
-    history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
-    checkpoint_.interval = out.checkpoint_every;
     if (comm_.is_root()) {  // rank 0 alone manages the folder (docs/parallel.md)
       std::filesystem::create_directories(dir_);
       // WLS (one rank only, refused on several): the integration regions (cut cells) beside
@@ -199,9 +186,7 @@ class Runner {
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
     if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
-    snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
-    history_.done = static_cast<long long>(data.scalars.at("history_done"));
-    checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
+    schedule_.restore(data.scalars);
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
     history_writer_.set_rows(rows_for_columns(data));
@@ -233,34 +218,24 @@ class Runner {
       write_history_row();
       write_snapshot();
     }
-    bool wrote_history = true, wrote_snapshot = true;
+    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads);
     while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
+      tuner.before_step();
+      const auto step_start = Clock::now();
       const double dt = sim_.next_dt();
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
         fail(f, dt);
       }
+      tuner.after_step(std::chrono::duration<double>(Clock::now() - step_start).count());
       last_dt_ = dt;
       max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
       measure_error();
       for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
       const double t = sim_.time();
-      wrote_history = wrote_snapshot = false;
-      if (history_.due(t)) {
-        history_.advance(t);
-        write_history_row();
-        wrote_history = true;
-      }
-      if (snapshot_.due(t)) {
-        snapshot_.advance(t);
-        write_snapshot();
-        wrote_snapshot = true;
-      }
-      if (checkpoint_.due(t)) {
-        checkpoint_.advance(t);
-        write_checkpoint_file();
-      }
+      schedule_.after_step(
+          t, [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint_file(); });
       const double wall_interval = config_.output.checkpoint_wall_interval;
       // On several ranks the autosave and the stop are decided together (any rank's clock or
       // signal), so that every rank writes the same checkpoint and stops at the same step.
@@ -275,8 +250,8 @@ class Runner {
       if (decide[1] != 0) interrupted(static_cast<int>(decide[1]));
       progress(start, first_step);
     }
-    if (!wrote_history) write_history_row();
-    if (!wrote_snapshot) write_snapshot();
+    tuner.finish();
+    schedule_.at_end([&] { write_history_row(); }, [&] { write_snapshot(); });
     flush_history();
     if (config_.output.checkpoints) write_checkpoint_file();
     progress(start, first_step, true);
@@ -296,6 +271,8 @@ class Runner {
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
     summary.stage_seconds = sim_.stage_times();
+    summary.adaptive_threads = tuner.enabled();
+    summary.single_thread_steps = tuner.single_thread_steps();
     if (const auto* c = sim_.contact()) {
       summary.contact_prepare_seconds = c->prepare_seconds();
       summary.contact_fit_seconds = c->fit_seconds();
@@ -418,10 +395,8 @@ class Runner {
                     {"dissipated_energy", sim_.dissipated_energy()},
                     {"next_full_mass_time", sim_.next_full_mass_time()},
                     {"initial_energy", initial_energy_},
-                    {"snapshots_done", static_cast<double>(snapshot_.done)},
-                    {"history_done", static_cast<double>(history_.done)},
-                    {"checkpoints_done", static_cast<double>(checkpoint_.done)},
                     {"checkpoint_index", static_cast<double>(checkpoint_index_)}};
+    schedule_.save(data.scalars);
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
@@ -521,7 +496,7 @@ class Runner {
   double max_imbalance_ = 1.0;
   std::filesystem::path dir_;
   OutputMetadata meta_;
-  Schedule history_, snapshot_, checkpoint_;
+  OutputSchedule schedule_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
   std::unique_ptr<SnapshotWriter<D>> cells_;  ///< WLS integration regions
