@@ -13,11 +13,13 @@
 #include <cstdlib>
 #include <iostream>
 #include <new>
+#include <sstream>
 
 #include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/sim/run.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/registry.hpp"
@@ -54,10 +56,17 @@ void describe(const cairn::Config& config) {
 }
 
 void print_summary(const cairn::RunSummary& s) {
-  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {} threads, "
+  const int threads = omp_get_max_threads();
+  const std::string workers =
+      s.ranks > 1 ? fmt::format("{} MPI ranks x {} thread{}", s.ranks, threads, threads == 1 ? "" : "s")
+                  : fmt::format("{} threads", threads);
+  fmt::print("cairn: {} steps to t = {:.6g} in {:.2f} s ({:.3g} {}-steps/s with {}, "
              "{} {}s)\n",
-             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, omp_get_max_threads(),
+             s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, workers,
              s.n_particles, s.item);
+  if (s.ranks > 1)
+    fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
+               s.partitions, s.migrated, s.max_imbalance);
   fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;
@@ -98,11 +107,17 @@ int main(int argc, char** argv) {
   // OpenMP threads that wait at a barrier sleep instead of spinning, unless the user chose a
   // policy: spinning makes 2 threads many times slower than 1 when another process is busy on
   // the machine (docs/performance.md, "Threads on a shared machine"). libgomp reads the policy
-  // when it loads, before main, so the process restarts itself once with it set (same pid).
+  // when it loads, before main, so the process restarts itself once with it set (same pid),
+  // before MPI is initialised.
   if (std::getenv("OMP_WAIT_POLICY") == nullptr && std::getenv("GOMP_SPINCOUNT") == nullptr) {
     ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
     ::execv("/proc/self/exe", argv);  // returns only on failure: go on with the runtime's default
   }
+  // Under mpirun/srun every rank runs this program (docs/parallel.md); rank 0 alone prints.
+  // Every rank reads and validates the input itself, so an input error stops them all with the
+  // same exit code; a simulation failure is detected collectively (exit 3 everywhere).
+  const cairn::MpiSession mpi(&argc, &argv);
+  const bool root = cairn::Comm::world().is_root();
   CLI::App app{"Cairn: material point method for dynamic solid mechanics"};
   app.set_version_flag("--version", std::string("cairn ") + CAIRN_VERSION);
   app.require_subcommand(1);
@@ -141,16 +156,27 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    if (e.get_exit_code() == 0) {  // --help, --version
+      std::ostringstream out, err;
+      const int code = app.exit(e, out, err);
+      if (root) {
+        std::cout << out.str();
+        std::cerr << err.str();
+      }
+      return code;
+    }
     std::string what = e.what();
     if (argc < 2) {
       what = "no command given";
     } else if (app.get_subcommands().empty()) {
       what = fmt::format("unknown command or option '{}'", argv[1]);
     }
-    std::cerr << "cairn: " << what << "\n" << usage;
+    if (root) std::cerr << "cairn: " << what << "\n" << usage;
     return 2;
   }
+  // Only rank 0 talks; the others' standard output and error stay quiet.
+  std::ostringstream discard;
+  std::ostream& err = root ? std::cerr : discard;
   if (threads > 0) {
     omp_set_num_threads(threads);
     // The command line wins over the input file's simulation.threads (docs/robustness.md).
@@ -159,11 +185,12 @@ int main(int argc, char** argv) {
 
   try {
     if (*keys) {
-      std::cout << cairn::keys_text(markdown);
+      if (root) std::cout << cairn::keys_text(markdown);
       return 0;
     }
     if (*check) {
       const cairn::Config config = cairn::load_config(input, overrides);
+      if (!root) return 0;
       print_warnings(config);
       std::cout << config.resolved_toml;
       describe(config);
@@ -174,33 +201,36 @@ int main(int argc, char** argv) {
     cairn::RunSummary summary;
     if (*run) {
       const cairn::Config config = cairn::load_config(input, overrides);
-      print_warnings(config);
+      if (root) print_warnings(config);
       summary = cairn::run(config, options);
     } else {
       summary = cairn::restart(input, overrides, options);
     }
-    if (!quiet) print_summary(summary);
+    if (!quiet && root) print_summary(summary);
     return 0;
   } catch (const cairn::InputError& e) {
-    std::cerr << "cairn: input error: " << e.what() << "\n";
+    err << "cairn: input error: " << e.what() << "\n";
     return 2;
   } catch (const cairn::UnknownName& e) {
-    std::cerr << "cairn: input error: " << e.what() << "\n";
+    err << "cairn: input error: " << e.what() << "\n";
     return 2;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "cairn: input error: " << e.what() << "\n";
+    err << "cairn: input error: " << e.what() << "\n";
     return 2;
   } catch (const cairn::RunFailure& e) {
-    std::cerr << "cairn: " << e.what() << "\n";
+    err << "cairn: " << e.what() << "\n";
     return 3;
   } catch (const cairn::RunInterrupted& e) {
-    std::cerr << "cairn: " << e.what() << "\n";
+    err << "cairn: " << e.what() << "\n";
     return 1;
   } catch (const std::bad_alloc&) {
+    // Other ranks may be waiting in a collective call: on several ranks, stop them all.
     std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";
+    if (cairn::Comm::world().parallel()) cairn::Comm::world().abort(1);
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "cairn: error: " << e.what() << "\n";
+    if (cairn::Comm::world().parallel()) cairn::Comm::world().abort(1);
     return 1;
   }
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cairn/parallel/exact_sum.hpp"
 #include "cairn/util/failure.hpp"
 
 namespace cairn {
@@ -20,7 +21,8 @@ MovingWall<D>::MovingWall(const WallConfig& config, const Grid<D>& grid, const C
 
 template <int D>
 void MovingWall<D>::prepare(const Grid<D>& grid, const NodeField<D>& nodes, double small_mass, double t,
-                            double dt, std::int32_t owner, std::vector<PrescribedVelocity<D>>& out) {
+                            double dt, std::int32_t owner, std::vector<PrescribedVelocity<D>>& out,
+                            const Comm& comm) {
   const int a = config_.axis;
   const double h = grid.cell_size()[a];
   const double lo = grid.origin()[a];
@@ -52,7 +54,7 @@ void MovingWall<D>::prepare(const Grid<D>& grid, const NodeField<D>& nodes, doub
   IVec<D> first = IVec<D>::Zero(), count = IVec<D>::Ones();
   for (int b = 0; b < D; ++b) {
     if (b == a) continue;
-    first[b] = grid.periodic(b) ? 0 : -ghost;
+    first[b] = grid.first_node(b);
     count[b] = grid.stored_nodes(b);
   }
   long long n_lines = 1;
@@ -76,19 +78,23 @@ void MovingWall<D>::prepare(const Grid<D>& grid, const NodeField<D>& nodes, doub
     g0 = gradient_(t);
     g1 = gradient_(t + dt);
   } else if (config_.gradient == WallGradient::estimate) {
-    // seed 000 Eq. 4, per line, lines weighted by m1 + m2.
+    // seed 000 Eq. 4, per line, lines weighted by m1 + m2. Summed exactly over the lines this
+    // rank owns (by node 1), then over the ranks: the same for every partition.
     const double dx1 = node_x(j1) - x_w, dx2 = node_x(j2) - x_w;
-    double num = 0.0, den = 0.0;
+    ExactSum sums[2];
+    ExactSum& num = sums[0];
+    ExactSum& den = sums[1];
     for (long long line = 0; line < n_lines; ++line) {
       const std::int32_t i1 = line_node(line, j1), i2 = line_node(line, j2);
-      if (i1 < 0 || i2 < 0) continue;
+      if (i1 < 0 || i2 < 0 || !grid.owns(i1)) continue;
       const double m1 = nodes.mass[i1], m2 = nodes.mass[i2];
       if (m1 <= small_mass || m2 <= small_mass) continue;
       const double dv1 = nodes.momentum[i1][a] / m1 - vb0, dv2 = nodes.momentum[i2][a] / m2 - vb0;
-      num += (m1 + m2) * (dv1 * dx1 + dv2 * dx2);
-      den += (m1 + m2) * (dx1 * dx1 + dx2 * dx2);
+      num.add((m1 + m2) * (dv1 * dx1 + dv2 * dx2));
+      den.add((m1 + m2) * (dx1 * dx1 + dx2 * dx2));
     }
-    g0 = g1 = den > 0.0 ? num / den : 0.0;
+    sum_across(comm, sums, 2);
+    g0 = g1 = den.value() > 0.0 ? num.value() / den.value() : 0.0;
   }
   velocity_start_ = vb0;
   gradient_start_ = g0;

@@ -26,6 +26,7 @@
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
+#include "cairn/parallel/comm.hpp"
 
 namespace cairn {
 
@@ -38,8 +39,10 @@ class MovingWall {
 
   /// Choose this step's controlled nodes, the gradient and the start/end values, and append them
   /// to `out` with owner index `owner`. Throws SimulationFailure when the wall has left the grid.
+  /// The estimated gradient sums over the lines of nodes `grid` owns and over the ranks of
+  /// `comm` (collective when it has more than one).
   void prepare(const Grid<D>& grid, const NodeField<D>& nodes, double small_mass, double t, double dt,
-               std::int32_t owner, std::vector<PrescribedVelocity<D>>& out);
+               std::int32_t owner, std::vector<PrescribedVelocity<D>>& out, const Comm& comm = Comm::serial());
   /// The step is done: the wall moves to its end-of-step position.
   void finish_step() { position_ = position_end_; }
 

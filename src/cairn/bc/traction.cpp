@@ -1,5 +1,6 @@
 #include "cairn/bc/traction.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -73,7 +74,7 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
             if (!in) continue;
           }
           faces_.push_back({static_cast<std::int32_t>(p), static_cast<std::int16_t>(a),
-                            static_cast<std::int16_t>(sign), static_cast<std::int32_t>(k)});
+                            static_cast<std::int16_t>(sign), static_cast<std::int32_t>(k), particles.id[p], true});
           ++load.n_faces;
         }
     }
@@ -84,6 +85,7 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
     loads_.push_back(std::move(load));
   }
 
+  all_faces_ = faces_;
   // One proxy particle per face: the particle's extent along the face, none along the normal.
   points_.resize(faces_.size());
   for (std::size_t q = 0; q < faces_.size(); ++q) {
@@ -129,7 +131,7 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
     points_.position[q] = particles.position[p] + static_cast<double>(f.sign) * R.col(f.axis);
     points_.deformation_gradient[q] = F;
     point_force_[q] = (factor * area) * loads_[f.load].traction;
-    loads_[f.load].total += point_force_[q];
+    if (f.owned) loads_[f.load].total += point_force_[q];
   }
 
   try {
@@ -148,15 +150,43 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
 }
 
 template <int D>
-double Tractions<D>::power(const std::vector<Vec<D>>& v, const std::vector<std::int32_t>* field_offset) const {
-  double w = 0.0;
+ExactSum Tractions<D>::power(const std::vector<Vec<D>>& v, const std::vector<std::int32_t>* field_offset) const {
+  ExactSum w;
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
+    if (!faces_[k].owned) continue;
     const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
+    double face = 0.0;
     for_each_entry(cache_, k, [&](std::int32_t node, double S, const Vec<D>&) {
-      w += S * point_force_[k].dot(v[node + off]);
+      face += S * point_force_[k].dot(v[node + off]);
     });
+    w.add(face);
   }
   return w;
+}
+
+template <int D>
+void Tractions<D>::localise(const Particles<D>& particles, std::size_t n_owned) {
+  if (loads_.empty()) return;
+  const auto ids = particles.id.begin();
+  const auto owned_end = ids + static_cast<std::ptrdiff_t>(n_owned);
+  const auto all_end = ids + static_cast<std::ptrdiff_t>(particles.n());
+  faces_.clear();
+  for (Face f : all_faces_) {
+    auto at = std::lower_bound(ids, owned_end, f.id);
+    f.owned = at != owned_end && *at == f.id;
+    if (!f.owned) {
+      at = std::lower_bound(owned_end, all_end, f.id);
+      if (at == all_end || *at != f.id) continue;
+    }
+    f.particle = static_cast<std::int32_t>(at - ids);
+    faces_.push_back(f);
+  }
+  points_.resize(faces_.size());
+  for (std::size_t q = 0; q < faces_.size(); ++q) {
+    points_.size0[q] = particles.size0[static_cast<std::size_t>(faces_[q].particle)];
+    points_.size0[q][faces_[q].axis] = 0.0;
+  }
+  point_force_.assign(faces_.size(), Vec<D>::Zero());
 }
 
 template class Tractions<1>;

@@ -44,6 +44,7 @@
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
+#include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/transfer/cache.hpp"
@@ -69,18 +70,25 @@ class Tractions {
   void add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
                   double t, std::vector<Vec<D>>& force,
                   const std::vector<std::int32_t>* field_offset = nullptr);
-  /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v).
-  [[nodiscard]] double power(const std::vector<Vec<D>>& v,
-                             const std::vector<std::int32_t>* field_offset = nullptr) const;
-  /// Total force of traction k at the last add_forces (sum over its faces of T A_s).
+  /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v),
+  /// over the faces of owned particles, summed exactly (the caller adds the ranks).
+  [[nodiscard]] ExactSum power(const std::vector<Vec<D>>& v,
+                               const std::vector<std::int32_t>* field_offset = nullptr) const;
+  /// Total force of traction k at the last add_forces (sum over the faces of owned particles of
+  /// T A_s).
   [[nodiscard]] Vec<D> total_force(std::size_t k) const { return loads_[k].total; }
+  /// A distributed run: load the faces of this rank's particles, owned ones [0, n_owned) and
+  /// ghost copies after them (each part in increasing id), keeping the setup's face order.
+  void localise(const Particles<D>& particles, std::size_t n_owned);
 
  private:
   struct Face {
-    std::int32_t particle;
+    std::int32_t particle;  ///< local index
     std::int16_t axis;  ///< normal axis a
     std::int16_t sign;  ///< -1: the min face, +1: the max face
     std::int32_t load;  ///< index into loads_
+    std::int64_t id = 0;  ///< the particle's id
+    bool owned = true;    ///< false: a ghost copy's face (forces only, no totals)
   };
   struct Load {
     Vec<D> traction = Vec<D>::Zero();
@@ -90,6 +98,7 @@ class Tractions {
   };
 
   std::vector<Face> faces_;
+  std::vector<Face> all_faces_;  ///< every loaded face of the run (setup order), for localise
   std::vector<Load> loads_;
   ParticleDomain domain_ = ParticleDomain::undeformed;
   double thickness_ = 1.0;

@@ -11,7 +11,8 @@ namespace cairn {
 
 template <int D>
 VelocityConditions<D>::VelocityConditions(const Config& config, const Grid<D>& grid,
-                                          const GridConditions<D>& faces) {
+                                          const GridConditions<D>& faces, bool require_nodes)
+    : grid_(&grid) {
   for (const auto& vc : config.velocity_conditions) {
     const std::string what = vc.where.str() + ": velocity condition '" + vc.name + "'";
     NodeSet set;
@@ -36,7 +37,7 @@ VelocityConditions<D>::VelocityConditions(const Config& config, const Grid<D>& g
         in = std::abs(x[vc.plane_axis] - vc.plane_at) <= 1e-6 * grid.cell_size()[vc.plane_axis];
       if (in) set.nodes.push_back(i);
     }
-    if (set.nodes.empty())
+    if (set.nodes.empty() && require_nodes)
       throw InputError(vc.where.file, vc.where.line,
                        fmt::format("velocity[{}]", &vc - config.velocity_conditions.data()),
                        "a selection (face, box_min/box_max, plane_axis/plane_at) holding at least one grid node",
@@ -51,6 +52,7 @@ VelocityConditions<D>::VelocityConditions(const Config& config, const Grid<D>& g
     kinds_.push_back("wall");
   }
   reactions_.assign(names_.size(), Vec<D>::Zero());
+  reaction_sum_.assign(D * names_.size(), ExactSum());
   if (empty()) return;
   face_mask_.assign(grid.n_nodes(), 0);
   for (std::size_t k = 0; k < faces.nodes().size(); ++k) face_mask_[faces.nodes()[k]] |= faces.masks()[k];
@@ -69,7 +71,7 @@ void VelocityConditions<D>::prepare(const Grid<D>& grid, const NodeField<D>& nod
     for (std::int32_t i : s.nodes) entries_.push_back({i, static_cast<std::int32_t>(k), s.direction, v0, v1});
   }
   for (std::size_t w = 0; w < walls_.size(); ++w)
-    walls_[w].prepare(grid, nodes, small_mass, t, dt, static_cast<std::int32_t>(sets_.size() + w), entries_);
+    walls_[w].prepare(grid, nodes, small_mass, t, dt, static_cast<std::int32_t>(sets_.size() + w), entries_, comm_);
   note_conflicts(grid);
 }
 
@@ -87,7 +89,8 @@ void VelocityConditions<D>::note_conflicts(const Grid<D>& grid) {
         "note: {} '{}' and {} both set the velocity of node {} at ({}) along non-orthogonal "
         "directions; '{}' takes precedence there (order: [boundary] faces, [[velocity]], [[wall]], "
         "later tables last; docs/boundary-conditions.md). Said once for this pair.",
-        kinds_[second], names_[second], a_name, node, where, names_[second]));
+        kinds_[second], names_[second], a_name, grid.whole().node_index(grid.multi_index(node)), where,
+        names_[second]));
   };
   for (std::size_t k = 0; k < entries_.size(); ++k) {
     const auto& e = entries_[k];
@@ -121,8 +124,7 @@ void VelocityConditions<D>::apply(std::vector<Vec<D>>& velocity, When when, std:
 template <int D>
 void VelocityConditions<D>::apply_step(NodeField<D>& nodes, double dt, bool constrain_start, std::int32_t offset,
                                        bool reset_reactions) {
-  if (reset_reactions)
-    for (auto& r : reactions_) r.setZero();
+  if (reset_reactions) reaction_sum_.assign(D * names_.size(), ExactSum());
   for (const auto& e : entries_) {
     const std::int32_t i = e.node + offset;
     const Vec<D>& n = e.direction;
@@ -134,10 +136,29 @@ void VelocityConditions<D>::apply_step(NodeField<D>& nodes, double dt, bool cons
     // seed 000 Sec. 2.4: a^(b) dt = (v^(b) - v^+UL . n) n, v^+UL from the corrected start.
     const double before = nodes.velocity_new[i].dot(n) + shift;
     const Vec<D> reaction = (nodes.mass[i] * (e.end - before) / dt) * n;
-    reactions_[e.owner] += reaction;
+    if (grid_->owns(e.node))
+      for (int a = 0; a < D; ++a) reaction_sum_[static_cast<std::size_t>(D * e.owner + a)].add(reaction[a]);
     nodes.reaction[i] += reaction;
     nodes.velocity_new[i] += (e.end - nodes.velocity_new[i].dot(n)) * n;
   }
+}
+
+template <int D>
+void VelocityConditions<D>::reduce_reactions() {
+  if (names_.empty()) return;
+  sum_across(comm_, reaction_sum_.data(), static_cast<int>(reaction_sum_.size()));
+  for (std::size_t k = 0; k < names_.size(); ++k)
+    for (int a = 0; a < D; ++a) reactions_[k][a] = reaction_sum_[D * k + a].value();
+}
+
+template <int D>
+void VelocityConditions<D>::take_state(VelocityConditions&& old) {
+  walls_ = std::move(old.walls_);
+  reactions_ = std::move(old.reactions_);
+  reaction_sum_ = std::move(old.reaction_sum_);
+  reported_ = std::move(old.reported_);
+  notes_ = std::move(old.notes_);
+  comm_ = old.comm_;
 }
 
 template class VelocityConditions<1>;

@@ -34,6 +34,7 @@
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
+#include "cairn/parallel/exact_sum.hpp"
 
 namespace cairn {
 
@@ -45,7 +46,15 @@ class VelocityConditions {
   VelocityConditions() = default;
   /// Select the node sets. Throws std::invalid_argument naming the table and its line when a
   /// [[velocity]] selects no node or an expression is bad.
-  VelocityConditions(const Config& config, const Grid<D>& grid, const GridConditions<D>& faces);
+  /// `require_nodes`: a [[velocity]] selecting no node of `grid` is an input error (the whole
+  /// grid at setup; a distributed run's windows may hold none of a set's nodes).
+  VelocityConditions(const Config& config, const Grid<D>& grid, const GridConditions<D>& faces,
+                     bool require_nodes = true);
+  /// Keep the run state of `old` (wall positions, reported conflicts, last reactions) when a
+  /// distributed run stores another window of the grid.
+  void take_state(VelocityConditions&& old);
+  /// The ranks over which reactions and wall gradients are summed (default: one).
+  void set_comm(const Comm& comm) { comm_ = comm; }
 
   [[nodiscard]] bool empty() const { return sets_.empty() && walls_.empty(); }
   /// Names of the conditions then the walls; the owner index of an entry points here.
@@ -67,7 +76,10 @@ class VelocityConditions {
   void apply_step(NodeField<D>& nodes, double dt, bool constrain_start, std::int32_t offset = 0,
                   bool reset_reactions = true);
 
-  /// Reaction force of each condition/wall (names() order) in the last apply_step.
+  /// Sum the reactions of the last apply_step calls over the nodes each rank owns and over the
+  /// ranks (collective); reactions() then holds them.
+  void reduce_reactions();
+  /// Reaction force of each condition/wall (names() order) in the last step (reduce_reactions).
   [[nodiscard]] const std::vector<Vec<D>>& reactions() const { return reactions_; }
   [[nodiscard]] const std::vector<MovingWall<D>>& walls() const { return walls_; }
   [[nodiscard]] std::vector<MovingWall<D>>& walls() { return walls_; }
@@ -90,6 +102,9 @@ class VelocityConditions {
   std::vector<std::string> kinds_;  ///< "velocity condition" or "wall", per owner
   std::vector<PrescribedVelocity<D>> entries_;
   std::vector<Vec<D>> reactions_;
+  std::vector<ExactSum> reaction_sum_;  ///< D per owner: this rank's share, exactly
+  const Grid<D>* grid_ = nullptr;
+  Comm comm_ = Comm::serial();
   std::vector<std::uint8_t> face_mask_;  ///< per node: components set by [boundary] faces
   std::vector<std::int32_t> claim_;      ///< per node: last entry of this step (scratch, -1)
   std::set<std::pair<int, int>> reported_;

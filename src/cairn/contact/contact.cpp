@@ -257,6 +257,8 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
   // Point clouds: the particles whose stencil holds the contact node (seed 004 Sec. 3.1, Fig. 3A).
   if (need_clouds_) {
     cloud_begin_.assign(nc + 1, 0);
+    // Particles in increasing id (a distributed run's ghosts included), as in a serial run.
+    auto particle_at = [&](std::int64_t k) { return cache.id_order.empty() ? k : std::int64_t{cache.id_order[static_cast<std::size_t>(k)]}; };
     for (std::int64_t p = 0; p < np; ++p)
       for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
         const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
@@ -266,7 +268,8 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
     cloud_weight_.resize(cloud_.size());
     std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
-    for (std::int64_t p = 0; p < np; ++p)
+    for (std::int64_t k = 0; k < np; ++k) {
+      const std::int64_t p = particle_at(k);
       for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
         const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
         if (c >= 0 && S > 0.0) {
@@ -275,6 +278,7 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
           cloud_weight_[at] = S;
         }
       });
+    }
   }
   // Normals and separations, node by node.
   const ScopedSeconds fit_lap(fit_seconds_);
@@ -425,14 +429,20 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
   const ScopedSeconds lap(correct_seconds_);
   if (record) {
     active_ = 0;
-    for (auto& f : pair_force_) f.setZero();
+    pair_force_sum_.assign(3 * pairs_.size(), ExactSum());
   }
+  // Forces and counts sum over the nodes this rank owns (all of them in a serial run), exactly,
+  // so that the totals do not depend on the partition (reduce() adds the ranks).
+  auto add_force = [&](int pair, const Vec3& f) {
+    for (int a = 0; a < 3; ++a) pair_force_sum_[static_cast<std::size_t>(3 * pair + a)].add(f[a]);
+  };
   const int nf = n_fields();
   constexpr int max_local = 64;
   std::array<Vec3, max_local> p, dp_total, dp_free;  // dp_free: the part from non-bonded laws
   std::array<double, max_local> m;
   for (std::size_t c = 0; c < nc; ++c) {
     const std::int32_t node = nodes_[c];
+    const bool counted = record && grid_->owns(node);
     const int b0 = field_begin_[c], b1 = field_begin_[c + 1];
     const int k = b1 - b0;
     if (k > max_local) throw std::runtime_error("contact: more than 64 fields at one node");
@@ -492,9 +502,9 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
         if (!laws_[static_cast<std::size_t>(law_of(it.a, other))]->bonded()) dp_free[la] = d;
         if (d.squaredNorm() > 0.0) {
           changed = true;
-          if (record) {
+          if (counted) {
             const int pi = pair_index_[static_cast<std::size_t>(it.a * nf + other)];
-            if (pi >= 0) pair_force_[static_cast<std::size_t>(pi)] += (it.a < other ? 1.0 : -1.0) * d / dt;
+            if (pi >= 0) add_force(pi, (it.a < other ? 1.0 : -1.0) * d / dt);
           }
         }
       }
@@ -524,15 +534,15 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
         if (biggest <= 1e-13 * scale) break;
       }
       for (int y = 0; y < k; ++y) changed = changed || dp_total[y].squaredNorm() > 0.0;
-      if (record && changed)
+      if (counted && changed)
         for (int x = i0; x < i1; ++x) {
           const Interaction& it = inter_[static_cast<std::size_t>(x)];
           const int pi = pair_index_[static_cast<std::size_t>(it.a * nf + it.b)];
-          if (pi >= 0) pair_force_[static_cast<std::size_t>(pi)] += (it.a < it.b ? 1.0 : -1.0) * inter_dp[x - i0] / dt;
+          if (pi >= 0) add_force(pi, (it.a < it.b ? 1.0 : -1.0) * inter_dp[x - i0] / dt);
         }
     }
     if (!changed) continue;
-    if (record) ++active_;
+    if (counted) ++active_;
     for (int x = b0; x < b1; ++x) {
       const std::size_t s = slot(x);
       const Vec3& d = dp_total[x - b0];
@@ -548,6 +558,25 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       }
     }
   }
+}
+
+template <int D>
+void Contact<D>::grid_changed() {
+  n_nodes_ = grid_->n_nodes();
+  nodes_.clear();
+  contact_of_.assign(static_cast<std::size_t>(n_nodes_), -1);
+}
+
+template <int D>
+void Contact<D>::reduce(const Comm& comm) {
+  sum_across(comm, pair_force_sum_.data(), static_cast<int>(pair_force_sum_.size()));
+  for (std::size_t k = 0; k < pairs_.size(); ++k)
+    for (int a = 0; a < 3; ++a) pair_force_[k][a] = pair_force_sum_.empty() ? 0.0 : pair_force_sum_[3 * k + a].value();
+  std::int64_t counts[2] = {static_cast<std::int64_t>(active_), 0};
+  for (std::int32_t c : nodes_) counts[1] += grid_->owns(c);
+  comm.sum(counts, 2);
+  active_total_ = static_cast<std::size_t>(counts[0]);
+  contact_total_ = static_cast<std::size_t>(counts[1]);
 }
 
 template <int D>

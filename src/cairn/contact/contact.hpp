@@ -21,6 +21,7 @@
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
 #include "cairn/materials/material.hpp"
+#include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/transfer/cache.hpp"
@@ -53,10 +54,15 @@ class Contact {
   void correct(const std::vector<double>& mass, std::vector<Vec<D>>& values, bool momentum, Pass pass,
                double time, double dt, std::vector<Vec<D>>* dv, std::vector<Vec<D>>* dv_impulse = nullptr);
 
-  /// Nodes that see two or more fields (last prepare).
-  [[nodiscard]] std::size_t contact_nodes() const { return nodes_.size(); }
-  /// Nodes where the last updated pass changed the momenta.
-  [[nodiscard]] std::size_t active_nodes() const { return active_; }
+  /// The grid passed to the constructor now stores another window (a distributed run).
+  void grid_changed();
+  /// Sum the updated pass's forces and counts over the ranks (collective; call once per step
+  /// after the updated pass, also in a serial run, before reading the three values below).
+  void reduce(const Comm& comm);
+  /// Nodes that see two or more fields (last prepare), over all ranks.
+  [[nodiscard]] std::size_t contact_nodes() const { return contact_total_; }
+  /// Nodes where the last updated pass changed the momenta, over all ranks.
+  [[nodiscard]] std::size_t active_nodes() const { return active_total_; }
   /// Pairs (a, b), a < b, reported in history: force on a from b of the last updated pass.
   [[nodiscard]] const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
   [[nodiscard]] const std::vector<Vec3>& pair_forces() const { return pair_force_; }
@@ -125,6 +131,8 @@ class Contact {
   // output of the updated pass
   std::vector<std::pair<int, int>> pairs_;
   std::vector<Vec3> pair_force_;
+  std::vector<ExactSum> pair_force_sum_;  ///< this rank's share, 3 per pair
+  std::size_t active_total_ = 0, contact_total_ = 0;
   std::vector<int> pair_index_;  ///< n_fields^2 -> index into pairs_
   std::size_t active_ = 0;
   double prepare_seconds_ = 0.0, fit_seconds_ = 0.0, correct_seconds_ = 0.0;

@@ -8,6 +8,7 @@
 #include "cairn/fem/output.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
+#include "cairn/io/output_schedule.hpp"
 #include "cairn/util/failure.hpp"
 
 namespace cairn::fem {
@@ -15,17 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Output times as integer counters (no drift with round-off), as in sim/run.cpp.
-struct Schedule {
-  double interval = 0.0;
-  long long done = 0;
-  [[nodiscard]] bool due(double t) const {
-    return interval > 0.0 && t >= static_cast<double>(done + 1) * interval * (1.0 - 1e-12);
-  }
-  void advance(double t) {
-    while (due(t)) ++done;
-  }
-};
 
 /// history.csv columns: the MPM run's columns that mean something for the FEM, then one
 /// reaction_<name>_<axis> per named [[velocity]] condition.
@@ -43,21 +33,15 @@ class Runner {
  public:
   Runner(const Config& config, const RunOptions& options)
       : config_(config), options_(options), solver_(config), dir_(config.output.directory),
-        history_writer_(dir_ / "history.csv", columns(config)), snapshots_(dir_) {
-    const auto& out = config_.output;
-    snapshot_.interval = out.every;
-    history_.interval = out.history_every > 0.0 ? out.history_every
-                                                : (out.every > 0.0 ? out.every : config_.simulation.end_time / 100.0);
-    checkpoint_.interval = out.checkpoint_every;
+        history_writer_(dir_ / "history.csv", columns(config)), snapshots_(dir_),
+        schedule_(config.output, config.simulation.end_time) {
     std::filesystem::create_directories(dir_);
   }
 
   void restore(const Checkpoint& c) {
     solver_.restore(c.state);
     initial_energy_ = c.scalars.at("initial_energy");
-    snapshot_.done = static_cast<long long>(c.scalars.at("snapshots_done"));
-    history_.done = static_cast<long long>(c.scalars.at("history_done"));
-    checkpoint_.done = static_cast<long long>(c.scalars.at("checkpoints_done"));
+    schedule_.restore(c.scalars);
     checkpoint_index_ = static_cast<int>(c.scalars.at("checkpoint_index"));
     last_dt_ = c.scalars.at("previous_dt");
     history_writer_.set_rows(c.history_rows);
@@ -75,7 +59,6 @@ class Runner {
       write_history_row();
       write_snapshot();
     }
-    bool wrote_history = true, wrote_snapshot = true;
     int last_decile = 0;
     while (solver_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || solver_.step_count() < s.max_steps)) {
       const double dt = solver_.next_dt();
@@ -86,29 +69,15 @@ class Runner {
       }
       last_dt_ = dt;
       const double t = solver_.time();
-      wrote_history = wrote_snapshot = false;
-      if (history_.due(t)) {
-        history_.advance(t);
-        write_history_row();
-        wrote_history = true;
-      }
-      if (snapshot_.due(t)) {
-        snapshot_.advance(t);
-        write_snapshot();
-        wrote_snapshot = true;
-      }
-      if (checkpoint_.due(t)) {
-        checkpoint_.advance(t);
-        write_checkpoint_file();
-      }
+      schedule_.after_step(
+          t, [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint_file(); });
       const int decile = static_cast<int>(10.0 * std::min(1.0, t / s.end_time));
       if (!options_.quiet && decile > last_decile) {
         last_decile = decile;
         std::fprintf(stderr, "  step %lld  t = %.6g  (%d%%)\n", solver_.step_count(), t, 10 * decile);
       }
     }
-    if (!wrote_history) write_history_row();
-    if (!wrote_snapshot) write_snapshot();
+    schedule_.at_end([&] { write_history_row(); }, [&] { write_snapshot(); });
     history_writer_.flush();
     if (config_.output.checkpoints) write_checkpoint_file();
 
@@ -155,11 +124,9 @@ class Runner {
     c.config_toml = config_.resolved_toml;
     c.state = solver_.state();
     c.scalars = {{"initial_energy", initial_energy_},
-                 {"snapshots_done", static_cast<double>(snapshot_.done)},
-                 {"history_done", static_cast<double>(history_.done)},
-                 {"checkpoints_done", static_cast<double>(checkpoint_.done)},
                  {"checkpoint_index", static_cast<double>(checkpoint_index_ + 1)},
                  {"previous_dt", last_dt_}};
+    schedule_.save(c.scalars);
     c.history_columns = history_writer_.columns();
     c.history_rows = history_writer_.rows();
     c.snapshots = snapshots_.entries();
@@ -187,7 +154,7 @@ class Runner {
   std::filesystem::path dir_;
   HistoryWriter history_writer_;
   SnapshotWriter snapshots_;
-  Schedule history_, snapshot_, checkpoint_;
+  OutputSchedule schedule_;
   double initial_energy_ = 0.0, last_dt_ = 0.0;
   int checkpoint_index_ = 0, rows_since_flush_ = 0;
   bool restarted_ = false;

@@ -93,6 +93,63 @@ void write_file_atomically(const fs::path& target,
   }
 }
 
+void write_file_atomically(const fs::path& target, const Comm& comm,
+                           const std::function<void(const fs::path& tmp)>& writer,
+                           const std::function<void(const fs::path& tmp)>& finish) {
+  if (!comm.parallel()) {
+    write_file_atomically(target, [&](const fs::path& tmp) {
+      writer(tmp);
+      if (finish) finish(tmp);
+    });
+    return;
+  }
+  // Rank 0 names the temporary file; every rank writes its part; rank 0 finishes and renames.
+  std::string tmp_name, error;
+  if (comm.is_root()) {
+    try {
+      const fs::path parent = target.parent_path();
+      std::error_code ec;
+      if (!parent.empty()) fs::create_directories(parent, ec);
+      tmp_name = create_atomic_temp(target).string();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  comm.broadcast(error, 0);
+  if (!error.empty()) throw std::runtime_error(error);
+  comm.broadcast(tmp_name, 0);
+  const fs::path tmp(tmp_name);
+  auto agree = [&](const std::string& mine) {
+    // The first rank with an error says what it is; every rank throws it.
+    const std::int64_t first = comm.min(mine.empty() ? std::int64_t{comm.size()} : std::int64_t{comm.rank()});
+    if (first == comm.size()) return;
+    std::string message = mine;
+    comm.broadcast(message, static_cast<int>(first));
+    if (comm.is_root()) {
+      std::error_code ignored;
+      fs::remove(tmp, ignored);
+    }
+    throw std::runtime_error(message);
+  };
+  try {
+    writer(tmp);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  agree(error);
+  if (comm.is_root()) {
+    try {
+      if (finish) finish(tmp);
+      std::error_code ec;
+      fs::rename(tmp, target, ec);
+      if (ec) error = "cannot rename '" + tmp.string() + "' to '" + target.string() + "': " + ec.message();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  agree(error);
+}
+
 void write_text_atomically(const fs::path& target, const std::string& text) {
   write_file_atomically(target, [&text, &target](const fs::path& tmp) {
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_TRUNC | O_NOFOLLOW | O_CLOEXEC);

@@ -13,6 +13,8 @@
 #include <functional>
 #include <string>
 
+#include "cairn/parallel/comm.hpp"
+
 namespace cairn {
 
 /// Create a new, empty temporary file `<target>.tmp.<pid>.<random>` next to `target` (the same
@@ -28,6 +30,13 @@ namespace cairn {
 void write_file_atomically(const std::filesystem::path& target,
                            const std::function<void(const std::filesystem::path& tmp)>& writer);
 
+/// The same for a file written collectively by the ranks of `comm` (parallel HDF5): rank 0
+/// creates the temporary file, every rank calls `writer(tmp)`, then rank 0 calls `finish(tmp)`
+/// (when given; e.g. a checksum read back from the closed file) and renames it. An error on any
+/// rank is thrown on every rank. With one rank: writer then finish, as above.
+void write_file_atomically(const std::filesystem::path& target, const Comm& comm,
+                           const std::function<void(const std::filesystem::path& tmp)>& writer,
+                           const std::function<void(const std::filesystem::path& tmp)>& finish = {});
 /// Write `text` verbatim (binary mode, no newline translation) to `target` atomically.
 /// Throws std::runtime_error naming the file and the system's reason if it cannot be written.
 void write_text_atomically(const std::filesystem::path& target, const std::string& text);

@@ -18,42 +18,41 @@ namespace {
 
 constexpr const char* format_name = "cairn-checkpoint";
 
-/// Space vectors are stored n x 3 (zero beyond D), the shape snapshots use (format version 2),
-/// written from the simulation's own storage (a Vec<D> is D contiguous doubles) without a copy.
+// Particle arrays are written from the simulation's own storage: vectors directly (a Vec<D> is D
+// contiguous doubles, stored n x 3 with zeros beyond D, the shape snapshots use: format version
+// 2), matrices (column-major in memory, row-major in the file) through a bounded block buffer,
+// so a checkpoint never holds a second copy of the particles.
 template <int D>
-void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, int deflate) {
+void write_vecs(hid_t loc, const std::string& name, const std::vector<Vec<D>>& v, h5::Rows rows, int deflate) {
   static_assert(sizeof(Vec<D>) == D * sizeof(double), "Vec<D> must be D packed doubles");
-  h5::write_doubles_padded(loc, name, reinterpret_cast<const double*>(v.data()), v.size(), D, 3, deflate);
+  h5::write_doubles_padded(loc, name, v.empty() ? nullptr : v.front().data(), rows, D, 3, deflate);
 }
 
 /// Reads n x 3 (version 2) or n x D (version 1) vectors.
 template <int D>
-std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t n) {
+/// Rows [first, first + n) of n x 3 (version 2) or n x D (version 1) vectors.
+std::vector<Vec<D>> read_vecs(hid_t loc, const std::string& name, std::size_t first, std::size_t n) {
   const std::vector<std::size_t> shape = h5::dataset_shape(loc, name);
   const std::size_t cols = shape.size() == 2 && shape[1] == 3 ? 3 : static_cast<std::size_t>(D);
-  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, cols});
+  const std::vector<double> buffer = h5::read_doubles_rows(loc, name, first, n, cols);
   std::vector<Vec<D>> v(n);
   for (std::size_t p = 0; p < n; ++p)
     for (int a = 0; a < D; ++a) v[p][a] = buffer[cols * p + a];
   return v;
 }
 
-// Matrices (column-major or symmetric in memory, row-major 3 x 3 in the file) go through a
-// bounded block buffer, so a checkpoint never holds a second copy of the particles.
+/// Mat3 or SymMat3 per particle, n x 9 row-major.
 template <class M>
-void write_mats(hid_t loc, const std::string& name, const std::vector<M>& m, int deflate) {
-  h5::write_doubles_blocked(
-      loc, name, m.size(), 9,
-      [&](std::size_t first, std::size_t count, double* out) {
-        for (std::size_t p = first; p < first + count; ++p)
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
-      },
-      deflate);
+void write_mats(hid_t loc, const std::string& name, const std::vector<M>& m, h5::Rows rows, int deflate) {
+  h5::write_doubles_blocked(loc, name, rows, 9, [&](std::size_t first, std::size_t count, double* out) {
+    for (std::size_t p = first; p < first + count; ++p)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) *out++ = m[p](i, j);
+  }, deflate);
 }
 
-std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t n) {
-  const std::vector<double> buffer = h5::read_doubles(loc, name, {n, 9});
+std::vector<Mat3> read_mats(hid_t loc, const std::string& name, std::size_t first, std::size_t n) {
+  const std::vector<double> buffer = h5::read_doubles_rows(loc, name, first, n, 9);
   std::vector<Mat3> m(n);
   for (std::size_t p = 0; p < n; ++p)
     for (int i = 0; i < 3; ++i)
@@ -126,6 +125,12 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data) {
 
 template <int D>
 void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const Particles<D>& particles) {
+  write_checkpoint(path, data, particles, Comm::serial());
+}
+
+template <int D>
+void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const Particles<D>& particles,
+                      const Comm& comm) {
   check_particles(particles);
   const std::size_t n_rows = data.history_rows.size();
   const std::size_t n_cols = n_rows > 0 ? data.history_rows.front().size() : data.history_columns.size();
@@ -134,8 +139,15 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
       throw std::invalid_argument("write_checkpoint: history rows have different lengths");
     }
   }
-  write_file_atomically(path, [&](const fs::path& tmp) {
-    h5::Handle file = h5::create_file(tmp);
+  // Particles rank after rank (one rank: all, in order), each with its id.
+  const h5::Rows rows = h5::rows_of(comm, particles.n());
+  auto checksum = [](const fs::path& tmp) {  // from the closed file, as one process
+    h5::Handle file(H5Fopen(tmp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+    if (file.get() < 0) throw std::runtime_error("cannot reopen '" + tmp.string() + "' for its checksum");
+    write_content_checksum(file.get());
+  };
+  write_file_atomically(path, comm, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp, comm);
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", format_name);
     h5::write_int64_attribute(root, "version", checkpoint_format_version);
@@ -180,31 +192,37 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     }
     {
       const Particles<D>& ps = particles;
-      const std::size_t n = ps.n();
-      const int z = data.metadata.compression;
+      const int z = comm.parallel() ? 0 : data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
       h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);
-      write_vecs<D>(gid, "position", ps.position, z);
-      write_vecs<D>(gid, "reference_position", ps.reference_position, z);
-      write_vecs<D>(gid, "velocity", ps.velocity, z);
-      h5::write_doubles(gid, "mass", ps.mass.data(), n);
-      h5::write_doubles(gid, "volume0", ps.volume0.data(), n);
-      if (ps.has_temperature) h5::write_doubles(gid, "temperature", ps.temperature.data(), n);
-      write_vecs<D>(gid, "size0", ps.size0, z);
-      write_mats(gid, "deformation_gradient", ps.deformation_gradient, z);
-      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, z);
-      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, z);
-      h5::write_ints(gid, "material", ps.material.data(), n);
-      h5::write_ints(gid, "body", ps.body.data(), n);
-      h5::write_doubles(gid, "state", ps.state.data(), ps.state.size(), 0, z);
+      write_vecs<D>(gid, "position", ps.position, rows, z);
+      write_vecs<D>(gid, "reference_position", ps.reference_position, rows, z);
+      write_vecs<D>(gid, "velocity", ps.velocity, rows, z);
+      h5::write_doubles_rows(gid, "mass", ps.mass.data(), rows);
+      h5::write_doubles_rows(gid, "volume0", ps.volume0.data(), rows);
+      if (ps.has_temperature) h5::write_doubles_rows(gid, "temperature", ps.temperature.data(), rows);
+      write_vecs<D>(gid, "size0", ps.size0, rows, z);
+      write_mats(gid, "deformation_gradient", ps.deformation_gradient, rows, z);
+      write_mats(gid, "kirchhoff_stress", ps.kirchhoff_stress, rows, z);
+      if (ps.has_affine) write_mats(gid, "affine_velocity", ps.affine_velocity, rows, z);
+      h5::write_ints_rows(gid, "material", ps.material.data(), rows);
+      h5::write_ints_rows(gid, "body", ps.body.data(), rows);
+      h5::write_int64s_rows(gid, "id", ps.id.data(), rows);
+      const auto n_state = static_cast<std::size_t>(ps.n_state_per_particle);
+      h5::write_doubles_rows(gid, "state", ps.state.data(),
+                             h5::Rows{rows.first * n_state, rows.count * n_state, rows.total * n_state}, 0, z);
     }
-    write_content_checksum(root);  // last: it covers everything above
-  });
+  }, checksum);  // the checksum last: it covers everything above
 }
 
 template <int D>
 CheckpointData<D> read_checkpoint(const fs::path& path) {
+  return read_checkpoint<D>(path, Comm::serial());
+}
+
+template <int D>
+CheckpointData<D> read_checkpoint(const fs::path& path, const Comm& comm) {
   int dimension = 0;
   h5::Handle file = open_checkpoint(path, dimension);
   if (dimension != D) {
@@ -212,12 +230,19 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
                                          path.string(), dimension, D));
   }
   const hid_t root = file.get();
-  if (std::string stored, computed; !content_checksum_matches(root, stored, computed))
+  // Rank 0 reads the whole file for the checksum; the verdict goes to every rank.
+  std::string verdict;
+  if (comm.is_root())
+    if (std::string stored, computed; !content_checksum_matches(root, stored, computed)) verdict = stored + " " + computed;
+  comm.broadcast(verdict, 0);
+  if (!verdict.empty()) {
+    const std::string stored = verdict.substr(0, verdict.find(' ')), computed = verdict.substr(verdict.find(' ') + 1);
     throw InputError(path.string(), 0, "checksum",
                      fmt::format("the content checksum stored when the checkpoint was written ({})", stored),
                      fmt::format("content with checksum {}: the file was changed or damaged after it "
                                  "was written, so it is refused",
                                  computed));
+  }
   CheckpointData<D> data;
   data.time = h5::read_double_attribute(root, "time");
   data.step = h5::read_int64_attribute(root, "step");
@@ -256,31 +281,43 @@ CheckpointData<D> read_checkpoint(const fs::path& path) {
     if (shape.size() != 1) {
       throw std::runtime_error("checkpoint '" + path.string() + "': /particles/mass is not 1D");
     }
-    const std::size_t n = shape[0];
+    const std::size_t total = shape[0];
     const long long n_state = h5::read_int64_attribute(gid, "n_state_per_particle");
     if (n_state < 0) {
       throw std::runtime_error("checkpoint '" + path.string() + "': negative n_state_per_particle");
     }
+    // On several ranks each reads an equal slab of rows; the run then sends every particle to
+    // its owner, so any number of ranks reads a checkpoint of any other number.
+    const auto ranks = static_cast<std::size_t>(comm.size()), rank = static_cast<std::size_t>(comm.rank());
+    const std::size_t first = total * rank / ranks, n = total * (rank + 1) / ranks - first;
+    const auto width = static_cast<std::size_t>(n_state);
     Particles<D>& ps = data.particles;
     ps.n_state_per_particle = static_cast<int>(n_state);
-    ps.position = read_vecs<D>(gid, "position", n);
-    ps.reference_position = read_vecs<D>(gid, "reference_position", n);
-    ps.velocity = read_vecs<D>(gid, "velocity", n);
-    ps.mass = h5::read_doubles(gid, "mass", {n});
-    ps.volume0 = h5::read_doubles(gid, "volume0", {n});
+    ps.position = read_vecs<D>(gid, "position", first, n);
+    ps.reference_position = read_vecs<D>(gid, "reference_position", first, n);
+    ps.velocity = read_vecs<D>(gid, "velocity", first, n);
+    ps.mass = h5::read_doubles_rows(gid, "mass", first, n);
+    ps.volume0 = h5::read_doubles_rows(gid, "volume0", first, n);
     ps.has_temperature = h5::has_child(gid, "temperature");
-    if (ps.has_temperature) ps.temperature = h5::read_doubles(gid, "temperature", {n});
-    ps.size0 = read_vecs<D>(gid, "size0", n);
-    ps.deformation_gradient = read_mats(gid, "deformation_gradient", n);
-    const std::vector<Mat3> tau = read_mats(gid, "kirchhoff_stress", n);
+    if (ps.has_temperature) ps.temperature = h5::read_doubles_rows(gid, "temperature", first, n);
+    ps.size0 = read_vecs<D>(gid, "size0", first, n);
+    ps.deformation_gradient = read_mats(gid, "deformation_gradient", first, n);
+    const std::vector<Mat3> tau = read_mats(gid, "kirchhoff_stress", first, n);
     ps.kirchhoff_stress.assign(tau.begin(), tau.end());
     // APIC runs store C_p; others leave it out (older files also hold velocity_gradient,
     // which is recomputed every step and not read).
     ps.has_affine = h5::has_child(gid, "affine_velocity");
-    if (ps.has_affine) ps.affine_velocity = read_mats(gid, "affine_velocity", n);
-    ps.material = h5::read_ints(gid, "material", n);
-    ps.body = h5::read_ints(gid, "body", n);
-    ps.state = h5::read_doubles(gid, "state", {n * static_cast<std::size_t>(n_state)});
+    if (ps.has_affine) ps.affine_velocity = read_mats(gid, "affine_velocity", first, n);
+    ps.material = h5::read_ints_rows(gid, "material", first, n);
+    ps.body = h5::read_ints_rows(gid, "body", first, n);
+    // Files written before particle ids: rows in creation order.
+    if (h5::has_child(gid, "id")) {
+      ps.id = h5::read_int64s_rows(gid, "id", first, n);
+    } else {
+      ps.id.resize(n);
+      for (std::size_t p = 0; p < n; ++p) ps.id[p] = static_cast<std::int64_t>(first + p);
+    }
+    ps.state = h5::read_doubles_rows(gid, "state", first * width, n * width);
   }
   return data;
 }
@@ -297,6 +334,12 @@ template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&);
 template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&, const Particles<1>&);
 template void write_checkpoint<2>(const fs::path&, const CheckpointData<2>&, const Particles<2>&);
 template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&, const Particles<3>&);
+template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&, const Particles<1>&, const Comm&);
+template void write_checkpoint<2>(const fs::path&, const CheckpointData<2>&, const Particles<2>&, const Comm&);
+template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&, const Particles<3>&, const Comm&);
+template CheckpointData<1> read_checkpoint<1>(const fs::path&, const Comm&);
+template CheckpointData<2> read_checkpoint<2>(const fs::path&, const Comm&);
+template CheckpointData<3> read_checkpoint<3>(const fs::path&, const Comm&);
 template CheckpointData<1> read_checkpoint<1>(const fs::path&);
 template CheckpointData<2> read_checkpoint<2>(const fs::path&);
 template CheckpointData<3> read_checkpoint<3>(const fs::path&);

@@ -16,7 +16,8 @@
 //   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
 //     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n,
 //     only for thermal runs), deformation_gradient, kirchhoff_stress and, for APIC runs only,
-//     affine_velocity (n x 9, row-major), material, body (int32, n), state
+//     affine_velocity (n x 9, row-major), material, body (int32, n), id (int64, n: the
+//     particle's number; a run on several MPI ranks stores its particles rank after rank), state
 //     (n * n_state_per_particle); version 1 files may also hold velocity_gradient (not read)
 #pragma once
 
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "cairn/io/metadata.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {
@@ -60,12 +62,22 @@ template <int D>
 void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data,
                       const Particles<D>& particles);
 
+/// The same written collectively by the ranks of `comm`, each passing its own particles (stored
+/// rank after rank with their ids; parallel HDF5, docs/parallel.md).
+template <int D>
+void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data,
+                      const Particles<D>& particles, const Comm& comm);
 /// Read a checkpoint written by write_checkpoint<D>. Throws std::runtime_error with a clear
 /// message if the file is missing, not HDF5, not a Cairn checkpoint, of another format version,
 /// of another dimension, or damaged.
 template <int D>
 CheckpointData<D> read_checkpoint(const std::filesystem::path& path);
 
+/// The same on each rank of `comm`: everything but the particles, and an equal share of the
+/// particle rows (any share: the run redistributes them; the file may come from any number of
+/// ranks). Rank 0 alone verifies the checksum.
+template <int D>
+CheckpointData<D> read_checkpoint(const std::filesystem::path& path, const Comm& comm);
 /// The simulation dimension stored in a checkpoint (checks format and version the same way).
 int checkpoint_dimension(const std::filesystem::path& path);
 

@@ -30,6 +30,41 @@ Handle simple_space(const std::vector<hsize_t>& dims, hid_t loc, const std::stri
                  "cannot create dataspace for", loc, name);
 }
 
+/// How the file holding `loc` is written: by one process, or collectively by the ranks of an
+/// MPI communicator (create_file with a parallel Comm).
+struct Access {
+  bool parallel = false;
+  bool root = true;
+  Handle transfer;  ///< dataset transfer properties (collective I/O when parallel)
+};
+
+Access access_of(hid_t loc) {
+  Access a;
+#ifdef H5_HAVE_PARALLEL
+  Handle file(H5Iget_file_id(loc), H5Fclose);
+  Handle fapl(H5Fget_access_plist(file.get()), H5Pclose);
+  if (fapl.get() >= 0 && H5Pget_driver(fapl.get()) == H5FD_MPIO) {
+    MPI_Comm comm = MPI_COMM_NULL;
+    MPI_Info info = MPI_INFO_NULL;
+    if (H5Pget_fapl_mpio(fapl.get(), &comm, &info) >= 0) {
+      int rank = 0;
+      MPI_Comm_rank(comm, &rank);
+      a.parallel = true;
+      a.root = rank == 0;
+      MPI_Comm_free(&comm);
+      if (info != MPI_INFO_NULL) MPI_Info_free(&info);
+      a.transfer = Handle(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+      H5Pset_dxpl_mpio(a.transfer.get(), H5FD_MPIO_COLLECTIVE);
+    }
+  }
+#else
+  (void)loc;
+#endif
+  return a;
+}
+
+hid_t transfer_of(const Access& a) { return a.parallel ? a.transfer.get() : H5P_DEFAULT; }
+
 /// Dataset creation properties: contiguous, or chunked with shuffle + gzip(`deflate`) when
 /// asked for and the dataset is large enough (whole rows per chunk, about 1 MiB).
 Handle creation_properties(const std::vector<hsize_t>& dims, std::size_t element_size, int deflate,
@@ -48,8 +83,11 @@ Handle creation_properties(const std::vector<hsize_t>& dims, std::size_t element
 }
 
 /// Create dataset `name` of file type `ftype` over `dims` and write `data` (memory type `mtype`).
+/// In a parallel file every rank passes the same data and rank 0 writes it.
 void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
                    const std::vector<hsize_t>& dims, const void* data, int deflate = 0) {
+  const Access a = access_of(loc);
+  if (a.parallel) deflate = 0;  // parallel files: no filters (docs/parallel.md)
   Handle space = simple_space(dims, loc, name);
   Handle dcpl = creation_properties(dims, H5Tget_size(ftype), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
@@ -58,9 +96,49 @@ void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
   if (total > 0) {
-    check(H5Dwrite(dset.get(), mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
+    Handle memory = simple_space(dims, loc, name);
+    if (!a.root) {
+      H5Sselect_none(space.get());
+      H5Sselect_none(memory.get());
+    }
+    check(H5Dwrite(dset.get(), mtype, memory.get(), space.get(), transfer_of(a), data),
           "cannot write dataset", loc, name);
   }
+}
+
+/// Create dataset `name` of `rows.total` x cols (cols = 0: 1D) and write this rank's rows.
+void write_dataset_rows(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype, Rows rows,
+                        std::size_t cols, const void* data, int deflate = 0) {
+  std::vector<hsize_t> dims{rows.total};
+  if (cols > 0) dims.push_back(cols);
+  const Access a = access_of(loc);
+  if (!a.parallel) {  // one process writes every row
+    if (rows.first != 0 || rows.count != rows.total) fail("a partial row range in a serial file for", loc, name);
+    write_dataset(loc, name, ftype, mtype, dims, data, deflate);
+    return;
+  }
+  Handle space = simple_space(dims, loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
+                                   H5P_DEFAULT, H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  if (rows.total == 0) return;
+  const double dummy = 0.0;
+  if (data == nullptr) data = &dummy;  // a rank without rows passes no buffer
+  std::vector<hsize_t> start(dims.size(), 0), count = dims;
+  start[0] = rows.first;
+  count[0] = rows.count;
+  std::vector<hsize_t> memory_dims = count;
+  memory_dims[0] = std::max<hsize_t>(count[0], 1);
+  Handle memory = simple_space(memory_dims, loc, name);
+  if (rows.count > 0) {
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+          "cannot select rows of", loc, name);
+  } else {
+    H5Sselect_none(space.get());
+    H5Sselect_none(memory.get());
+  }
+  check(H5Dwrite(dset.get(), mtype, memory.get(), space.get(), transfer_of(a), data), "cannot write dataset",
+        loc, name);
 }
 
 Handle open_dataset(hid_t loc, const std::string& name) {
@@ -181,12 +259,18 @@ std::string describe(hid_t loc, const std::string& name) {
   return "'" + file + ":" + object + "'";
 }
 
-Handle create_file(const fs::path& path) {
+Handle create_file(const fs::path& path, const Comm& comm) {
   silence_errors();
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   if (fapl.get() < 0 || H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0) {
     throw std::runtime_error("HDF5: cannot set up file access for '" + path.string() + "'");
   }
+#if defined(H5_HAVE_PARALLEL) && defined(CAIRN_HAVE_MPI)
+  if (comm.parallel() && H5Pset_fapl_mpio(fapl.get(), comm.handle(), MPI_INFO_NULL) < 0)
+    throw std::runtime_error("HDF5: cannot set up parallel access for '" + path.string() + "'");
+#else
+  if (comm.parallel()) throw std::runtime_error("HDF5: this build has no parallel HDF5 for '" + path.string() + "'");
+#endif
   hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
   if (id < 0) throw std::runtime_error("HDF5: cannot create file '" + path.string() + "'");
   return Handle(id, H5Fclose);
@@ -233,38 +317,155 @@ void write_doubles_shaped(hid_t loc, const std::string& name, const double* data
 }
 
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
-                           int deflate) {
-  const std::vector<hsize_t> dims{rows, cols};
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate) {
+  write_doubles_blocked(loc, name, Rows{0, rows, rows}, cols, fill, deflate);
+}
+
+void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::size_t cols,
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate) {
+  const Access a = access_of(loc);
+  const std::vector<hsize_t> dims{rows.total, cols};
   Handle space = simple_space(dims, loc, name);
-  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), a.parallel ? 0 : deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                    dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
-  if (rows == 0 || cols == 0) return;
+  if (rows.total == 0 || cols == 0) return;
   // 2^17 doubles: the rows of one chunk when compressed (creation_properties), so blocks align.
   const std::size_t block = std::max<std::size_t>(1, (std::size_t{1} << 17) / cols);
-  std::vector<double> buffer(std::min(rows, block) * cols);
-  for (std::size_t first = 0; first < rows; first += block) {
-    const std::size_t count = std::min(block, rows - first);
-    fill(first, count, buffer.data());
-    const hsize_t start[2] = {first, 0}, extent[2] = {count, cols};
-    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, extent, nullptr),
-          "cannot select rows of", loc, name);
-    Handle memory = simple_space({count, cols}, loc, name);
-    check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, buffer.data()),
+  std::vector<double> buffer(std::max<std::size_t>(std::min(rows.count, block), 1) * cols);
+  // Collective I/O: every rank takes part in the same number of writes (an empty selection
+  // once its rows are done).
+  std::size_t n_blocks = (rows.count + block - 1) / block;
+  if (a.parallel) {
+    std::int64_t most = static_cast<std::int64_t>(n_blocks);
+    Comm::world().max(&most, 1);
+    n_blocks = static_cast<std::size_t>(most);
+  }
+  for (std::size_t b = 0; b < n_blocks; ++b) {
+    const std::size_t first = b * block;
+    const std::size_t count = first < rows.count ? std::min(block, rows.count - first) : 0;
+    if (count > 0) fill(first, count, buffer.data());
+    const hsize_t start[2] = {rows.first + first, 0}, extent[2] = {count, cols};
+    Handle memory = simple_space({std::max<hsize_t>(count, 1), cols}, loc, name);
+    if (count > 0) {
+      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, extent, nullptr),
+            "cannot select rows of", loc, name);
+    } else {
+      H5Sselect_none(space.get());
+      H5Sselect_none(memory.get());
+    }
+    check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), transfer_of(a), buffer.data()),
           "cannot write dataset", loc, name);
   }
 }
 
+void write_doubles_rows(hid_t loc, const std::string& name, const double* data, Rows rows, std::size_t cols,
+                        int deflate) {
+  write_dataset_rows(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rows, cols, data, deflate);
+}
+
+void write_ints_rows(hid_t loc, const std::string& name, const std::int32_t* data, Rows rows, int deflate) {
+  write_dataset_rows(loc, name, H5T_STD_I32LE, H5T_NATIVE_INT32, rows, 0, data, deflate);
+}
+
+void write_int64s_rows(hid_t loc, const std::string& name, const std::int64_t* data, Rows rows, int deflate) {
+  write_dataset_rows(loc, name, H5T_STD_I64LE, H5T_NATIVE_INT64, rows, 0, data, deflate);
+}
+
+void write_doubles_box(hid_t loc, const std::string& name, const double* data, const std::vector<std::size_t>& shape,
+                       const std::vector<std::size_t>& start, const std::vector<std::size_t>& count, int deflate) {
+  const Access a = access_of(loc);
+  if (!a.parallel) {  // one process: the box is the whole dataset
+    if (start != std::vector<std::size_t>(start.size(), 0) || count != shape)
+      fail("a partial box in a serial file for", loc, name);
+    write_doubles_shaped(loc, name, data, shape, deflate);
+    return;
+  }
+  const std::vector<hsize_t> dims(shape.begin(), shape.end());
+  Handle space = simple_space(dims, loc, name);
+  Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                   H5P_DEFAULT, H5P_DEFAULT),
+                        H5Dclose, "cannot create dataset", loc, name);
+  const std::vector<hsize_t> first(start.begin(), start.end()), extent(count.begin(), count.end());
+  hsize_t n = 1;
+  for (hsize_t c : extent) n *= c;
+  std::vector<hsize_t> memory_dims = extent;
+  for (hsize_t& d : memory_dims) d = std::max<hsize_t>(d, 1);
+  Handle memory = simple_space(memory_dims, loc, name);
+  if (n > 0) {
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, first.data(), nullptr, extent.data(), nullptr),
+          "cannot select a box of", loc, name);
+  } else {
+    H5Sselect_none(space.get());
+    H5Sselect_none(memory.get());
+  }
+  const double dummy = 0.0;
+  check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), transfer_of(a), n > 0 ? data : &dummy),
+        "cannot write dataset", loc, name);
+}
+
+std::vector<double> read_doubles_rows(hid_t loc, const std::string& name, std::size_t first, std::size_t count,
+                                      std::size_t cols) {
+  Handle dset = open_dataset(loc, name);
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  const std::vector<std::size_t> shape = space_shape(space.get(), loc, name);
+  if (shape.empty() || first + count > shape[0] || (cols == 0 ? shape.size() != 1 : shape.size() != 2 || shape[1] != cols))
+    fail("unexpected shape of", loc, name);
+  std::vector<double> data(count * std::max<std::size_t>(cols, 1));
+  if (count == 0) return data;
+  std::vector<hsize_t> start(shape.size(), 0), extent(shape.begin(), shape.end());
+  start[0] = first;
+  extent[0] = count;
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start.data(), nullptr, extent.data(), nullptr),
+        "cannot select rows of", loc, name);
+  Handle memory = simple_space(extent, loc, name);
+  check(H5Dread(dset.get(), H5T_NATIVE_DOUBLE, memory.get(), space.get(), H5P_DEFAULT, data.data()),
+        "cannot read dataset", loc, name);
+  return data;
+}
+
+template <class T>
+std::vector<T> read_integers_rows(hid_t loc, const std::string& name, std::size_t first, std::size_t count,
+                                  hid_t mtype) {
+  Handle dset = open_dataset(loc, name);
+  Handle space = checked(H5Dget_space(dset.get()), H5Sclose, "cannot get the dataspace of", loc, name);
+  const std::vector<std::size_t> shape = space_shape(space.get(), loc, name);
+  if (shape.size() != 1 || first + count > shape[0]) fail("unexpected shape of", loc, name);
+  std::vector<T> data(count);
+  if (count == 0) return data;
+  const hsize_t start[1] = {first}, extent[1] = {count};
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, extent, nullptr), "cannot select rows of",
+        loc, name);
+  Handle memory = simple_space({count}, loc, name);
+  check(H5Dread(dset.get(), mtype, memory.get(), space.get(), H5P_DEFAULT, data.data()), "cannot read dataset", loc,
+        name);
+  return data;
+}
+
+std::vector<std::int32_t> read_ints_rows(hid_t loc, const std::string& name, std::size_t first, std::size_t count) {
+  return read_integers_rows<std::int32_t>(loc, name, first, count, H5T_NATIVE_INT32);
+}
+
+std::vector<std::int64_t> read_int64s_rows(hid_t loc, const std::string& name, std::size_t first, std::size_t count) {
+  return read_integers_rows<std::int64_t>(loc, name, first, count, H5T_NATIVE_INT64);
+}
+
 void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
                           std::size_t mem_cols, std::size_t file_cols, int deflate) {
+  write_doubles_padded(loc, name, data, Rows{0, rows, rows}, mem_cols, file_cols, deflate);
+}
+
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, Rows rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate) {
   if (mem_cols == file_cols) {
-    write_doubles(loc, name, data, rows, file_cols, deflate);
+    write_doubles_rows(loc, name, data, rows, file_cols, deflate);
     return;
   }
   if (mem_cols > file_cols) fail("more columns in memory than in the file for", loc, name);
-  const std::vector<hsize_t> dims{rows, file_cols};
+  const Access a = access_of(loc);
+  if (a.parallel) deflate = 0;
+  const std::vector<hsize_t> dims{rows.total, file_cols};
   Handle space = simple_space(dims, loc, name);
   Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
   const double zero = 0.0;
@@ -274,13 +475,20 @@ void write_doubles_padded(hid_t loc, const std::string& name, const double* data
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                    dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
-  if (rows == 0 || mem_cols == 0) return;
-  // The first mem_cols columns of the file, from a dense rows x mem_cols array in memory.
-  const hsize_t start[2] = {0, 0}, count[2] = {rows, mem_cols};
-  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
-        "cannot select columns of", loc, name);
-  Handle mspace = simple_space({rows, mem_cols}, loc, name);
-  check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, mspace.get(), space.get(), H5P_DEFAULT, data),
+  if (rows.total == 0 || mem_cols == 0) return;
+  // The first mem_cols columns of this rank's rows, from a dense rows x mem_cols array in memory.
+  const hsize_t start[2] = {rows.first, 0}, count[2] = {rows.count, mem_cols};
+  Handle mspace = simple_space({std::max<hsize_t>(rows.count, 1), mem_cols}, loc, name);
+  if (rows.count > 0) {
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr),
+          "cannot select columns of", loc, name);
+  } else {
+    H5Sselect_none(space.get());
+    H5Sselect_none(mspace.get());
+  }
+  const double dummy = 0.0;
+  check(H5Dwrite(dset.get(), H5T_NATIVE_DOUBLE, mspace.get(), space.get(), transfer_of(a),
+                 rows.count > 0 ? data : &dummy),
         "cannot write dataset", loc, name);
 }
 
@@ -316,7 +524,13 @@ void write_text(hid_t loc, const std::string& name, const std::string& text) {
                         H5Dclose, "cannot create dataset", loc, name);
   std::string buffer = text;
   buffer.resize(std::max<std::size_t>(text.size(), 1), '\0');
-  check(H5Dwrite(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+  const Access a = access_of(loc);
+  Handle memory = checked(H5Screate(H5S_SCALAR), H5Sclose, "cannot create dataspace for", loc, name);
+  if (!a.root) {  // a parallel file: rank 0 writes what every rank passes
+    H5Sselect_none(space.get());
+    H5Sselect_none(memory.get());
+  }
+  check(H5Dwrite(dset.get(), type.get(), memory.get(), space.get(), transfer_of(a), buffer.data()),
         "cannot write dataset", loc, name);
 }
 

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "cairn/parallel/comm.hpp"
+
 namespace cairn {
 struct OutputMetadata;
 }
@@ -57,8 +59,44 @@ class Handle {
   Closer close_ = nullptr;
 };
 
-/// Create (truncate) an HDF5 file for writing.
-[[nodiscard]] Handle create_file(const std::filesystem::path& path);
+/// Create (truncate) an HDF5 file for writing; with a `comm` of several ranks every rank calls
+/// this and every write below collectively (parallel HDF5, docs/parallel.md): the plain writes
+/// then take the same data on every rank (rank 0 writes it), the *_rows writes each rank's rows.
+[[nodiscard]] Handle create_file(const std::filesystem::path& path, const Comm& comm = Comm::serial());
+/// This rank's rows [first, first + count) of a dataset of `total` rows.
+struct Rows {
+  std::size_t first = 0;
+  std::size_t count = 0;
+  std::size_t total = 0;
+};
+/// Rows of the ranks' local counts n, rank after rank (collective).
+[[nodiscard]] inline Rows rows_of(const Comm& comm, std::size_t n) {
+  const auto local = static_cast<std::int64_t>(n);
+  return Rows{static_cast<std::size_t>(comm.exclusive_prefix(local)), n, static_cast<std::size_t>(comm.sum(local))};
+}
+/// Distributed datasets: rows.total rows (x cols when cols > 0), this rank writing its rows. In
+/// a file of one process (rows = all of them) they are write_doubles/write_ints with `deflate`;
+/// a parallel file stores them uncompressed.
+void write_doubles_rows(hid_t loc, const std::string& name, const double* data, Rows rows, std::size_t cols = 0,
+                        int deflate = 0);
+void write_ints_rows(hid_t loc, const std::string& name, const std::int32_t* data, Rows rows, int deflate = 0);
+void write_int64s_rows(hid_t loc, const std::string& name, const std::int64_t* data, Rows rows, int deflate = 0);
+/// write_doubles_blocked for this rank's rows of a distributed dataset.
+void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::size_t cols,
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate = 0);
+/// A double dataset of `shape` of which this rank writes the box [start, start + count) from
+/// `data` (the box's values, row-major); an empty box writes nothing. One process: the box is
+/// the whole dataset (write_doubles_shaped with `deflate`).
+void write_doubles_box(hid_t loc, const std::string& name, const double* data, const std::vector<std::size_t>& shape,
+                       const std::vector<std::size_t>& start, const std::vector<std::size_t>& count,
+                       int deflate = 0);
+/// Rows [first, first + count) of a 1D (cols = 0) or rows x cols dataset.
+[[nodiscard]] std::vector<double> read_doubles_rows(hid_t loc, const std::string& name, std::size_t first,
+                                                    std::size_t count, std::size_t cols = 0);
+[[nodiscard]] std::vector<std::int32_t> read_ints_rows(hid_t loc, const std::string& name, std::size_t first,
+                                                       std::size_t count);
+[[nodiscard]] std::vector<std::int64_t> read_int64s_rows(hid_t loc, const std::string& name, std::size_t first,
+                                                         std::size_t count);
 /// Open an existing HDF5 file read-only. Throws if it does not exist or is not HDF5.
 [[nodiscard]] Handle open_file(const std::filesystem::path& path);
 /// Create a group `name` below `loc`.
@@ -84,12 +122,14 @@ void write_doubles_shaped(hid_t loc, const std::string& name, const double* data
 /// when compressed), so an array whose memory layout differs from the file's is written without
 /// a copy of the whole array.
 void write_doubles_blocked(hid_t loc, const std::string& name, std::size_t rows, std::size_t cols,
-                           const std::function<void(std::size_t, std::size_t, double*)>& fill,
-                           int deflate = 0);
+                           const std::function<void(std::size_t, std::size_t, double*)>& fill, int deflate = 0);
 /// Write a rows x `file_cols` double dataset from rows x `mem_cols` values in memory (row-major,
 /// mem_cols <= file_cols): columns mem_cols.. are zero. Space vectors of D < 3 components are
 /// stored this way with 3 columns, without a padded copy.
 void write_doubles_padded(hid_t loc, const std::string& name, const double* data, std::size_t rows,
+                          std::size_t mem_cols, std::size_t file_cols, int deflate = 0);
+/// The same for this rank's rows of a distributed dataset (parallel HDF5).
+void write_doubles_padded(hid_t loc, const std::string& name, const double* data, Rows rows,
                           std::size_t mem_cols, std::size_t file_cols, int deflate = 0);
 /// Create `view` below `loc` as an HDF5 virtual dataset showing columns [first, first + cols) of
 /// the rows x source_cols double dataset `source_path` (absolute path in the same file): no data

@@ -901,6 +901,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.threads = r.small_integer("threads");
   s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
+  s.rebalance_threshold = r.real("rebalance_threshold");
   s.max_estimated_steps = r.real("max_estimated_steps");
   s.body_overlap = r.string("body_overlap");
   s.where = locate(r.path_of("end_time"), r.given("end_time") ? r.given("end_time") : section(root, "simulation"));
@@ -1710,6 +1711,7 @@ std::string config_to_toml(const Config& c) {
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
+  line("rebalance_threshold", real_text(s.rebalance_threshold));
   line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));
   line("max_estimated_steps", real_text(s.max_estimated_steps));

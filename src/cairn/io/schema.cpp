@@ -106,6 +106,13 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("0")
                 .min(0)
                 .max(1024));
+  k.push_back(Key("simulation", "rebalance_threshold", T::real,
+                 "Runs on several MPI ranks (docs/parallel.md): repartition the domain when the "
+                 "largest particle count of a rank exceeds the mean count by more than this "
+                 "fraction (history column `imbalance` = largest / mean); checked every step. A "
+                 "large value (e.g. 1e9) keeps the start-up partition. Unused on one rank.")
+                .by_default("0.25")
+                .min(0.0));
   k.push_back(Key("simulation", "memory_limit", T::real,
                  "GiB of memory the setup may need (grid nodes, particles, transfer caches, "
                  "estimated before anything is allocated); 0 = the machine's memory (its cgroup "

@@ -67,8 +67,8 @@ const char* xdmf_header() {
 }  // namespace
 
 template <int D>
-SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem, OutputMetadata meta)
-    : directory_(std::move(directory)), stem_(std::move(stem)), meta_(std::move(meta)) {
+SnapshotWriter<D>::SnapshotWriter(fs::path directory, std::string stem, OutputMetadata meta, const Comm& comm)
+    : directory_(std::move(directory)), stem_(std::move(stem)), meta_(std::move(meta)), comm_(comm) {
   if (stem_.empty()) throw std::invalid_argument("snapshot file stem must not be empty");
 }
 
@@ -149,54 +149,71 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
                              3.0 * (syz * syz + sxz * sxz + sxy * sxy));
   }
 
+  // Particles rank after rank (one rank: all of them, in order).
+  const h5::Rows rows = h5::rows_of(comm_, n);
+  for (std::size_t p = 0; p < n; ++p) connectivity[p] = static_cast<std::int32_t>(rows.first + p);
+
   // Grid node data over the domain nodes j = 0..n_cells per axis (no ghost layers; a periodic
-  // axis repeats its first node at the end), x fastest, shape slowest axis first.
+  // axis repeats its first node at the end), x fastest, shape slowest axis first. Each rank
+  // writes the box of those nodes it owns (all of them on one rank).
   FileInfo file_info;
   file_info.readable = true;
   file_info.current = true;
-  file_info.n_particles = n;
+  file_info.n_particles = rows.total;
   std::vector<double> node_mass, node_velocity, node_normal;
+  std::vector<std::size_t> box_start, box_count, vbox_start, vbox_count;
   if (with_grid) {
     file_info.has_grid = true;
     file_info.origin.assign(3, 0.0);
     file_info.spacing.assign(3, 1.0);
+
     for (int a = 0; a < D; ++a) {
       file_info.origin[a] = grid->origin()[a];
       file_info.spacing[a] = grid->cell_size()[a];
     }
-    IVec<D> count;
-    std::size_t nn = 1;
+    IVec<D> lo, hi;  // owned domain nodes [lo, hi): those whose cell (clamped) this rank owns
     for (int a = 0; a < D; ++a) {
-      count[a] = grid->n_cells()[a] + 1;
-      nn *= static_cast<std::size_t>(count[a]);
+      lo[a] = grid->own_lo()[a];
+      hi[a] = grid->own_hi()[a] == grid->n_cells()[a] ? grid->n_cells()[a] + 1 : grid->own_hi()[a];
     }
-    for (int a = D - 1; a >= 0; --a) file_info.node_shape.push_back(static_cast<std::size_t>(count[a]));
+    for (int a = D - 1; a >= 0; --a) {
+      file_info.node_shape.push_back(static_cast<std::size_t>(grid->n_cells()[a] + 1));
+      box_start.push_back(static_cast<std::size_t>(lo[a]));
+      box_count.push_back(static_cast<std::size_t>(hi[a] - lo[a]));
+    }
+    vbox_start = box_start;
+    vbox_start.push_back(0);
+    vbox_count = box_count;
+    vbox_count.push_back(3);
     const bool normals = contact_normals && contact_normals->size() == static_cast<std::size_t>(grid->n_nodes());
-    file_info.has_contact_normal = normals;
-    node_mass.assign(nn, 0.0);
-    node_velocity.assign(3 * nn, 0.0);
-    if (normals) node_normal.assign(3 * nn, 0.0);
-    for (std::size_t k = 0; k < nn; ++k) {
-      IVec<D> j;
-      std::size_t rest = k;
-      for (int a = 0; a < D; ++a) {
-        j[a] = static_cast<int>(rest % static_cast<std::size_t>(count[a]));
-        rest /= static_cast<std::size_t>(count[a]);
-      }
+    file_info.has_contact_normal = comm_.any(normals);
+    // The owned box in file order (x fastest).
+    std::size_t box_nodes = 1;
+    for (int a = 0; a < D; ++a) box_nodes *= static_cast<std::size_t>(hi[a] - lo[a]);
+    node_mass.assign(box_nodes, 0.0);
+    node_velocity.assign(3 * box_nodes, 0.0);
+    if (file_info.has_contact_normal) node_normal.assign(3 * box_nodes, 0.0);
+    IVec<D> j = lo;
+    for (std::size_t k = 0; k < box_nodes; ++k) {
       const auto i = static_cast<std::size_t>(grid->node_index(j));
       node_mass[k] = nodes->mass[i];
       for (int a = 0; a < D; ++a) node_velocity[3 * k + a] = nodes->velocity_new[i][a];
       if (normals)
         for (int a = 0; a < 3; ++a) node_normal[3 * k + a] = (*contact_normals)[i][a];
+      for (int a = 0; a < D; ++a) {
+        if (++j[a] < hi[a]) break;
+        j[a] = lo[a];
+      }
     }
   }
 
   const fs::path target = snapshot_path(next_index_);
-  const int z = meta_.compression;
+  // Parallel HDF5 here writes no filtered (compressed) datasets: several ranks write plain ones.
+  const int z = comm_.parallel() ? 0 : meta_.compression;
   const std::string length = meta_.unit(Quantity::length), vel = meta_.unit(Quantity::velocity);
   const std::string stress_unit = meta_.unit(Quantity::stress), mass_unit = meta_.unit(Quantity::mass);
-  write_file_atomically(target, [&](const fs::path& tmp) {
-    h5::Handle file = h5::create_file(tmp);
+  write_file_atomically(target, comm_, [&](const fs::path& tmp) {
+    h5::Handle file = h5::create_file(tmp, comm_);
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", "cairn-snapshot");
     h5::write_int64_attribute(root, "format_version", snapshot_format_version);
@@ -208,54 +225,59 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
     {
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
-      h5::write_doubles(gid, "position", position.data(), n, 3, z);
+      h5::write_doubles_rows(gid, "position", position.data(), rows, 3, z);
       h5::describe_dataset(gid, "position", length, "current position x (zero beyond D)", "x y z");
-      h5::write_doubles(gid, "velocity", velocity.data(), n, 3, z);
+      h5::write_doubles_rows(gid, "velocity", velocity.data(), rows, 3, z);
       h5::describe_dataset(gid, "velocity", vel, "velocity v", "x y z");
-      h5::write_doubles(gid, "displacement", displacement.data(), n, 3, z);
+      h5::write_doubles_rows(gid, "displacement", displacement.data(), rows, 3, z);
       h5::describe_dataset(gid, "displacement", length, "x - X (current minus reference position)", "x y z");
-      h5::write_doubles(gid, "mass", particles.mass.data(), n, 0, z);
+      h5::write_doubles_rows(gid, "mass", particles.mass.data(), rows, 0, z);
       h5::describe_dataset(gid, "mass", mass_unit, "particle mass (per unit thickness times the thickness in 2D)");
-      h5::write_doubles(gid, "volume", volume.data(), n, 0, z);
+      h5::write_doubles_rows(gid, "volume", volume.data(), rows, 0, z);
       h5::describe_dataset(gid, "volume", meta_.unit(Quantity::volume), "current volume det(F) V0");
-      h5::write_doubles(gid, "stress", stress.data(), n, 6, z);
+      h5::write_doubles_rows(gid, "stress", stress.data(), rows, 6, z);
       h5::describe_dataset(gid, "stress", stress_unit,
                            "Cauchy stress sigma = tau / det(F), symmetric, VTK order", "xx yy zz xy yz xz");
-      h5::write_doubles(gid, "deformation_gradient", deformation.data(), n, 9, z);
+      h5::write_doubles_rows(gid, "deformation_gradient", deformation.data(), rows, 9, z);
       h5::describe_dataset(gid, "deformation_gradient", "1", "F = dx/dX, row-major: F_iJ at 3 i + J",
                            "xx xy xz yx yy yz zx zy zz");
       for (int i = 0; i < 3; ++i) {
         const std::string row = std::string("deformation_gradient_") + "xyz"[i];
-        h5::write_column_view(gid, row, "/particles/deformation_gradient", n, 9, 3 * static_cast<std::size_t>(i), 3);
+        h5::write_column_view(gid, row, "/particles/deformation_gradient", rows.total, 9,
+                              3 * static_cast<std::size_t>(i), 3);
         h5::describe_dataset(gid, row, "1", fmt::format("row {} of F (a view of deformation_gradient)", "xyz"[i]),
                              fmt::format("{0}x {0}y {0}z", "xyz"[i]));
       }
-      h5::write_doubles(gid, "pressure", pressure.data(), n, 0, z);
+      h5::write_doubles_rows(gid, "pressure", pressure.data(), rows, 0, z);
       h5::describe_dataset(gid, "pressure", stress_unit, "-trace(sigma)/3");
-      h5::write_doubles(gid, "von_mises", von_mises.data(), n, 0, z);
+      h5::write_doubles_rows(gid, "von_mises", von_mises.data(), rows, 0, z);
       h5::describe_dataset(gid, "von_mises", stress_unit, "von Mises equivalent stress of sigma");
       std::vector<double> zero;  // runs without a thermal model store no temperatures
       if (particles.temperature.size() != n) zero.assign(n, 0.0);
-      h5::write_doubles(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), n, 0, z);
+      h5::write_doubles_rows(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), rows, 0, z);
       h5::describe_dataset(gid, "temperature", meta_.unit(Quantity::temperature), "temperature");
-      h5::write_ints(gid, "material", particles.material.data(), n, z);
+      h5::write_ints_rows(gid, "material", particles.material.data(), rows, z);
       h5::describe_dataset(gid, "material", "1", "index into /material_names");
-      h5::write_ints(gid, "body", particles.body.data(), n, z);
+      h5::write_ints_rows(gid, "body", particles.body.data(), rows, z);
       h5::describe_dataset(gid, "body", "1", "index into /body_names");
-      h5::write_ints(gid, "connectivity", connectivity.data(), n, z);
+      if (particles.id.size() == n) {
+        h5::write_int64s_rows(gid, "id", particles.id.data(), rows, z);
+        h5::describe_dataset(gid, "id", "1", "the particle's number (creation order), on any number of MPI ranks");
+      }
+      h5::write_ints_rows(gid, "connectivity", connectivity.data(), rows, z);
       h5::describe_dataset(gid, "connectivity", "1", "0..n-1: one vertex cell per particle (XDMF Polyvertex)");
     }
     if (with_grid) {
       h5::Handle g = h5::create_group(root, "grid");
       const hid_t gid = g.get();
-      h5::write_doubles_shaped(gid, "node_mass", node_mass.data(), file_info.node_shape, z);
+      h5::write_doubles_box(gid, "node_mass", node_mass.data(), file_info.node_shape, box_start, box_count, z);
       h5::describe_dataset(gid, "node_mass", mass_unit, "lumped node mass");
       std::vector<std::size_t> vshape = file_info.node_shape;
       vshape.push_back(3);
-      h5::write_doubles_shaped(gid, "node_velocity", node_velocity.data(), vshape, z);
+      h5::write_doubles_box(gid, "node_velocity", node_velocity.data(), vshape, vbox_start, vbox_count, z);
       h5::describe_dataset(gid, "node_velocity", vel, "node velocity after the grid update", "x y z");
       if (file_info.has_contact_normal) {
-        h5::write_doubles_shaped(gid, "contact_normal", node_normal.data(), vshape, z);
+        h5::write_doubles_box(gid, "contact_normal", node_normal.data(), vshape, vbox_start, vbox_count, z);
         h5::describe_dataset(gid, "contact_normal", "1", "unit contact normal (zero away from contact)", "x y z");
       }
       h5::write_doubles_attribute(gid, "origin", file_info.origin);
@@ -275,7 +297,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   }
   if (!replaced) entries_.emplace_back(time, name);
   ++next_index_;
-  write_xdmf();
+  if (comm_.is_root()) write_xdmf();
 }
 
 template <int D>
@@ -408,7 +430,11 @@ void SnapshotWriter<D>::restore(std::vector<Entry> entries, int next_index) {
   set_next_index(next_index);
   // Files of this series numbered next_index or later belong to the abandoned continuation of
   // the run: remove them, so that the folder, the XDMF files and history.csv all end at the
-  // restored time.
+  // restored time. On several ranks rank 0 alone touches the files.
+  if (!comm_.is_root()) {
+    comm_.barrier();
+    return;
+  }
   std::error_code ec;
   const fs::path folder = directory_ / "snapshots";
   if (fs::is_directory(folder, ec)) {
@@ -426,6 +452,7 @@ void SnapshotWriter<D>::restore(std::vector<Entry> entries, int next_index) {
     for (const auto& p : stale) fs::remove(p, ec);
   }
   write_xdmf();
+  comm_.barrier();
 }
 
 template class SnapshotWriter<1>;

@@ -21,12 +21,15 @@
 //   /particles/deformation_gradient  n x 9, row-major (F_xx, F_xy, F_xz, F_yx, ...), and its rows
 //     deformation_gradient_x/_y/_z (n x 3 virtual views, no extra data) for ParaView
 //   /particles/material, body        int32, n (indices into /material_names, /body_names)
+//   /particles/id                    int64, n: the particle's number (creation order); a run on
+//                                    several MPI ranks stores its particles rank after rank
 //   /particles/connectivity          int32, 0..n-1 (the XDMF Polyvertex cells)
 //   /grid (optional): node_mass (shape [nz,] [ny,] nx) and node_velocity (same shape x 3) over
 //     the domain nodes j = 0..n_cells per axis (no ghost layers), x fastest; attributes origin
 //     and spacing (x y z, padded with 0 and 1). grid.xdmf shows it as a 3D mesh (one node thick
 //     in the missing directions) in the particles' coordinates.
-// Large datasets are chunked and gzip-compressed when output.compression > 0.
+// Large datasets are chunked and gzip-compressed when output.compression > 0 (one rank only:
+// parallel HDF5 writes no compressed datasets here, a run on several ranks writes them plain).
 #pragma once
 
 #include <filesystem>
@@ -37,6 +40,7 @@
 
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/metadata.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {
@@ -55,8 +59,11 @@ class SnapshotWriter {
 
   /// Snapshots go to `directory`/snapshots, index files to `directory`. Nothing is written
   /// until the first write(). `meta` describes the run in every file (units, names, input).
+  /// A `comm` of several ranks writes collectively (parallel HDF5): each rank passes its own
+  /// particles (they are stored rank after rank, each with its id) and its grid window (each
+  /// rank writes the nodes it owns); rank 0 writes the XDMF files (docs/parallel.md).
   explicit SnapshotWriter(std::filesystem::path directory, std::string stem = "particles",
-                          OutputMetadata meta = {});
+                          OutputMetadata meta = {}, const Comm& comm = Comm::serial());
 
   /// Write snapshot number next_index() of `particles` at `time`/`step` and rewrite the XDMF
   /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
@@ -109,6 +116,7 @@ class SnapshotWriter {
   std::filesystem::path directory_;
   std::string stem_;
   OutputMetadata meta_;
+  Comm comm_;
   int next_index_ = 0;
   std::vector<Entry> entries_;
   std::map<std::string, FileInfo> info_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "cairn/math/sym_mat3.hpp"
@@ -27,6 +28,10 @@ struct Particles {
   std::vector<double> temperature;      ///< temperature; stored only when has_temperature
   std::vector<std::int32_t> material;   ///< index into the simulation's material list
   std::vector<std::int32_t> body;       ///< index of the [[body]] the particle came from
+  /// Particle number in creation order, kept for the particle's life: it names the particle in
+  /// messages and outputs of every rank count, and a distributed run adds each node's
+  /// contributions in increasing id, as a serial run does (docs/parallel.md).
+  std::vector<std::int64_t> id;
   /// Material state variables, n_state_per_particle doubles per particle (0 for elastic laws).
   std::vector<double> state;
   int n_state_per_particle = 0;
@@ -38,6 +43,34 @@ struct Particles {
   bool has_temperature = true;
 
   [[nodiscard]] std::size_t n() const { return position.size(); }
+
+  /// fn(array, width) for every per-particle array: `width` entries per particle (0 for an
+  /// array that is not stored). Migration between ranks, ghost copies, reordering and restarts
+  /// go through this one list, so an array added to the struct must be added here (a unit test
+  /// compares the list with the struct's size).
+  template <class Fn>
+  void for_each_array(Fn&& fn) {
+    fn(position, 1);
+    fn(reference_position, 1);
+    fn(velocity, 1);
+    fn(mass, 1);
+    fn(volume0, 1);
+    fn(size0, 1);
+    fn(deformation_gradient, 1);
+    fn(kirchhoff_stress, 1);
+    fn(affine_velocity, has_affine ? 1 : 0);
+    fn(temperature, has_temperature ? 1 : 0);
+    fn(material, 1);
+    fn(body, 1);
+    fn(id, 1);
+    fn(state, n_state_per_particle);
+  }
+  template <class Fn>
+  void for_each_array(Fn&& fn) const {
+    const_cast<Particles*>(this)->for_each_array([&](auto& array, int width) { fn(std::as_const(array), width); });
+  }
+  /// Number of per-particle arrays for_each_array visits.
+  static constexpr int n_arrays = 14;
 
   void resize(std::size_t n) {
     position.resize(n);
@@ -52,24 +85,15 @@ struct Particles {
     temperature.resize(has_temperature ? n : 0, 0.0);
     material.resize(n);
     body.resize(n);
+    const std::size_t numbered = id.size();
+    id.resize(n);
+    for (std::size_t p = numbered; p < n; ++p) id[p] = static_cast<std::int64_t>(p);
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
   }
 
   /// Release the spare capacity that adding particles one by one leaves (up to half the arrays).
   void shrink_to_fit() {
-    position.shrink_to_fit();
-    reference_position.shrink_to_fit();
-    velocity.shrink_to_fit();
-    mass.shrink_to_fit();
-    volume0.shrink_to_fit();
-    size0.shrink_to_fit();
-    deformation_gradient.shrink_to_fit();
-    kirchhoff_stress.shrink_to_fit();
-    affine_velocity.shrink_to_fit();
-    temperature.shrink_to_fit();
-    material.shrink_to_fit();
-    body.shrink_to_fit();
-    state.shrink_to_fit();
+    for_each_array([](auto& array, int) { array.shrink_to_fit(); });
   }
 
   /// Append one particle; F = I, zero stress.
@@ -87,6 +111,7 @@ struct Particles {
     if (has_temperature) temperature.push_back(0.0);
     material.push_back(mat);
     body.push_back(bod);
+    id.push_back(static_cast<std::int64_t>(id.size()));
     state.resize(state.size() + static_cast<std::size_t>(n_state_per_particle), 0.0);
   }
 };

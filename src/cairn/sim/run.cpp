@@ -18,8 +18,10 @@
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/run.hpp"
 #include "cairn/io/checkpoint.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/input.hpp"
+#include "cairn/io/output_schedule.hpp"
 #include "cairn/io/snapshot.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
@@ -115,20 +117,11 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
       for (int k = 0; k < D; ++k)
         columns.push_back(fmt::format("contact_{}_{}_{}", c->field_names()[a], c->field_names()[b], "xyz"[k]));
   }
+  // Runs on several ranks, last: the particle imbalance (largest count of a rank / mean count)
+  // at the start of the last step; the other columns are those of a serial run, bit for bit.
+  if (sim.comm().parallel()) columns.push_back("imbalance");
   return columns;
 }
-
-/// Output schedule as integer counters so that output times do not drift with round-off.
-struct Schedule {
-  double interval = 0.0;
-  long long done = 0;  ///< outputs written at t > 0
-  [[nodiscard]] bool due(double t) const {
-    return interval > 0.0 && t >= static_cast<double>(done + 1) * interval * (1.0 - 1e-12);
-  }
-  void advance(double t) {
-    while (due(t)) ++done;
-  }
-};
 
 template <int D>
 class Runner {
@@ -136,23 +129,25 @@ class Runner {
   Runner(const Config& config, const RunOptions& options)
       : config_(config),
         options_(options),
-        sim_(config),
+        sim_(config, Comm::world()),
+        comm_(sim_.comm()),
         dir_(config.output.directory),
         meta_(output_metadata(config)),
-        snapshots_(dir_, "particles", meta_) {
+        schedule_(config.output, config.simulation.end_time),
+        snapshots_(dir_, "particles", meta_, comm_) {
     const auto& out = config_.output;
-    const double end = config_.simulation.end_time;
-    snapshot_.interval = out.every;
-    history_.interval = out.history_every > 0.0 ? out.history_every : (out.every > 0.0 ? out.every : end / 100.0);
-    checkpoint_.interval = out.checkpoint_every;
-    std::filesystem::create_directories(dir_);
-    // WLS: the integration regions (cut cells) beside every particle snapshot, wls_cells.xdmf.
-    if (sim_.wls()) cells_ = std::make_unique<SnapshotWriter<D>>(dir_, "wls_cells");
+    if (comm_.is_root()) {  // rank 0 alone manages the folder (docs/parallel.md)
+      std::filesystem::create_directories(dir_);
+      // WLS (one rank only, refused on several): the integration regions (cut cells) beside
+      // every particle snapshot, wls_cells.xdmf.
+      if (sim_.wls()) cells_ = std::make_unique<SnapshotWriter<D>>(dir_, "wls_cells");
+      remove_orphan_temporaries(dir_);
+      remove_orphan_temporaries(dir_ / "snapshots");
+    }
+    comm_.barrier();
     if (!out.exact_displacement.empty())
       for (int t = 0; t < omp_get_max_threads(); ++t)
         exact_.push_back(std::make_unique<ExpressionVector<D>>(out.exact_displacement, config_.constants));
-    remove_orphan_temporaries(dir_);
-    remove_orphan_temporaries(dir_ / "snapshots");
   }
 
   /// An exception leaving the run (a full disk, a failed output) still leaves the history rows
@@ -160,7 +155,7 @@ class Runner {
   ~Runner() {
     if (std::uncaught_exceptions() == 0) return;
     try {
-      history_writer_.flush();
+      flush_history();
     } catch (const std::exception&) {
       // the exception in flight says what went wrong
     }
@@ -169,8 +164,20 @@ class Runner {
   Runner& operator=(const Runner&) = delete;
 
   void restore(const CheckpointData<D>& data) {
-    check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
-    sim_.particles() = data.particles;
+    // Each rank checks its share of the rows; a bad row stops every rank with the same message.
+    std::string problem;
+    try {
+      check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
+    } catch (const InputError& e) {
+      if (!comm_.parallel()) throw;
+      problem = e.what();
+    }
+    const std::int64_t first_bad = comm_.min(problem.empty() ? std::int64_t{comm_.size()} : std::int64_t{comm_.rank()});
+    if (first_bad < comm_.size()) {
+      comm_.broadcast(problem, static_cast<int>(first_bad));
+      throw std::invalid_argument(problem);
+    }
+    sim_.set_particles(data.particles);
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
                           data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
     auto& walls = sim_.velocity_conditions().walls();
@@ -178,14 +185,12 @@ class Runner {
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
     if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
-    snapshot_.done = static_cast<long long>(data.scalars.at("snapshots_done"));
-    history_.done = static_cast<long long>(data.scalars.at("history_done"));
-    checkpoint_.done = static_cast<long long>(data.scalars.at("checkpoints_done"));
+    schedule_.restore(data.scalars);
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
-    history_writer_.set_rows(data.history_rows);
+    history_writer_.set_rows(rows_for_columns(data));
     // Every output ends where the checkpoint stands, before the first new step.
-    history_writer_.flush();
+    flush_history();
     snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
     if (cells_) {
       // The region files are written in step with the particle files: same index, other stem.
@@ -203,15 +208,15 @@ class Runner {
     last_autosave_ = start;
     const long long first_step = sim_.step_count();
     const auto& s = config_.simulation;
+    n_particles_ = sim_.total_particles();
     if (!restarted_) {
-      if (const std::string note = time_step_note(config_); !note.empty())
+      if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
         std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
       measure_error();
       write_history_row();
       write_snapshot();
     }
-    bool wrote_history = true, wrote_snapshot = true;
     while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
       const double dt = sim_.next_dt();
       try {
@@ -220,36 +225,28 @@ class Runner {
         fail(f, dt);
       }
       last_dt_ = dt;
+      max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
       measure_error();
-      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());
+      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
       const double t = sim_.time();
-      wrote_history = wrote_snapshot = false;
-      if (history_.due(t)) {
-        history_.advance(t);
-        write_history_row();
-        wrote_history = true;
-      }
-      if (snapshot_.due(t)) {
-        snapshot_.advance(t);
-        write_snapshot();
-        wrote_snapshot = true;
-      }
-      if (checkpoint_.due(t)) {
-        checkpoint_.advance(t);
-        write_checkpoint_file();
-      }
+      schedule_.after_step(
+          t, [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint_file(); });
       const double wall_interval = config_.output.checkpoint_wall_interval;
-      if (config_.output.checkpoints && wall_interval > 0.0 &&
-          std::chrono::duration<double>(Clock::now() - last_autosave_).count() >= wall_interval) {
+      // On several ranks the autosave and the stop are decided together (any rank's clock or
+      // signal), so that every rank writes the same checkpoint and stops at the same step.
+      std::int64_t decide[2] = {config_.output.checkpoints && wall_interval > 0.0 &&
+                                    std::chrono::duration<double>(Clock::now() - last_autosave_).count() >= wall_interval,
+                                static_cast<std::int64_t>(stop_signal)};
+      comm_.max(decide, 2);
+      if (decide[0] != 0) {
         write_checkpoint_file(true);
         last_autosave_ = Clock::now();
       }
-      if (stop_signal != 0) interrupted(static_cast<int>(stop_signal));
+      if (decide[1] != 0) interrupted(static_cast<int>(decide[1]));
       progress(start, first_step);
     }
-    if (!wrote_history) write_history_row();
-    if (!wrote_snapshot) write_snapshot();
-    history_writer_.flush();
+    schedule_.at_end([&] { write_history_row(); }, [&] { write_snapshot(); });
+    flush_history();
     if (config_.output.checkpoints) write_checkpoint_file();
     progress(start, first_step, true);
     finish_progress();
@@ -258,7 +255,11 @@ class Runner {
     summary.steps = sim_.step_count() - first_step;
     summary.end_time = sim_.time();
     summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    summary.n_particles = sim_.particles().n();
+    summary.n_particles = static_cast<std::size_t>(n_particles_);
+    summary.ranks = comm_.size();
+    summary.partitions = sim_.distribution().partitions();
+    summary.migrated = comm_.sum(sim_.distribution().received());
+    summary.max_imbalance = max_imbalance_;
     summary.particle_steps_per_second =
         summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
     summary.output_directory = dir_;
@@ -295,8 +296,8 @@ class Runner {
         worst = std::max(worst, (P.position[p] - X - u(X, X, t)).norm());
       }
     }
-    error_now_ = worst;
-    error_max_ = std::max(error_max_, worst);
+    error_now_ = comm_.max(worst);  // over every rank's owned particles
+    error_max_ = std::max(error_max_, error_now_);
   }
 
   void write_history_row() {
@@ -319,17 +320,45 @@ class Runner {
       for (const auto& f : c->pair_forces())
         for (int a = 0; a < D; ++a) row.push_back(f[a]);
     }
+    if (comm_.parallel()) row.push_back(sim_.imbalance());
+    // Every rank keeps the rows (they are global sums, the same everywhere; checkpoints hold
+    // them), rank 0 alone writes the file.
     history_writer_.add_row(sim_.time(), sim_.step_count(), last_dt_, row);
     ++rows_since_flush_;
     if (rows_since_flush_ >= 20) {
-      history_writer_.flush();
+      flush_history();
       rows_since_flush_ = 0;
     }
   }
 
+  /// The checkpoint's history rows in this run's columns: the same columns unless the run that
+  /// wrote it had another number of ranks (the column `imbalance` exists on several ranks only;
+  /// rows restored onto several ranks from a one-rank checkpoint say 1 there).
+  std::vector<std::vector<double>> rows_for_columns(const CheckpointData<D>& data) const {
+    const auto& now = history_writer_.columns();
+    if (data.history_columns == now) return data.history_rows;
+    std::vector<std::vector<double>> rows;
+    for (const auto& stored : data.history_rows) {
+      std::vector<double> row;
+      for (const auto& name : now) {
+        const auto at = std::find(data.history_columns.begin(), data.history_columns.end(), name);
+        if (at != data.history_columns.end() && static_cast<std::size_t>(at - data.history_columns.begin()) < stored.size())
+          row.push_back(stored[static_cast<std::size_t>(at - data.history_columns.begin())]);
+        else if (name == "imbalance")
+          row.push_back(1.0);
+      }
+      rows.push_back(std::move(row));  // a row still short of a column is refused by set_rows
+    }
+    return rows;
+  }
+
+  void flush_history() {
+    if (comm_.is_root()) history_writer_.flush();
+  }
+
   void write_snapshot() {
     if (!config_.output.snapshots) return;
-    history_writer_.flush();
+    flush_history();
     if (config_.output.grid_snapshots)
     {
       const NodeField<D> nodes = sim_.grid_totals();
@@ -358,10 +387,8 @@ class Runner {
                     {"dissipated_energy", sim_.dissipated_energy()},
                     {"next_full_mass_time", sim_.next_full_mass_time()},
                     {"initial_energy", initial_energy_},
-                    {"snapshots_done", static_cast<double>(snapshot_.done)},
-                    {"history_done", static_cast<double>(history_.done)},
-                    {"checkpoints_done", static_cast<double>(checkpoint_.done)},
                     {"checkpoint_index", static_cast<double>(checkpoint_index_)}};
+    schedule_.save(data.scalars);
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
@@ -370,13 +397,13 @@ class Runner {
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
     data.metadata = meta_;
-    write_checkpoint<D>(path, data, sim_.particles());  // no copy of the particles
+    write_checkpoint<D>(path, data, sim_.particles(), comm_);  // no copy of the particles
     last_checkpoint_ = path;
   }
 
   /// SIGINT/SIGTERM: keep the history, save the state, say where, and stop.
   [[noreturn]] void interrupted(int signo) {
-    history_writer_.flush();
+    flush_history();
     finish_progress();
     const char* name = signo == SIGINT ? "SIGINT" : signo == SIGTERM ? "SIGTERM" : "a signal";
     std::string saved = "no checkpoint written (output.checkpoints = false)";
@@ -390,10 +417,10 @@ class Runner {
 
   /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
   [[noreturn]] void fail(const SimulationFailure& f, double dt) {
-    history_writer_.flush();
+    flush_history();
     std::string saved;
     try {
-      SnapshotWriter<D> failure(dir_, "failure", meta_);
+      SnapshotWriter<D> failure(dir_, "failure", meta_, comm_);
       failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
@@ -407,9 +434,9 @@ class Runner {
 
   /// On a terminal: a bar with percentage, step, time, throughput and an ETA from the simulated
   /// time per wall second smoothed over about 10 s (redrawn at most 4 times a second; `final`
-  /// draws the finished state). Elsewhere: one line per 10 %.
+  /// draws the finished state). Elsewhere: one line per 10 %. Rank 0 alone on several ranks.
   void progress(Clock::time_point start, long long first_step, bool final = false) {
-    if (options_.quiet) return;
+    if (options_.quiet || !comm_.is_root()) return;
     const auto now = Clock::now();
     const double end = config_.simulation.end_time;
     const double frac = final ? 1.0 : std::clamp(sim_.time() / end, 0.0, 1.0);
@@ -424,7 +451,7 @@ class Runner {
       }
       last_progress_ = now;
       last_progress_time_ = sim_.time();
-      const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(sim_.particles().n()) / elapsed : 0.0;
+      const double rate = elapsed > 0 ? (sim_.step_count() - first_step) * double(n_particles_) / elapsed : 0.0;
       const std::string eta = final ? "done in " + duration_text(elapsed)
                               : smoothed_speed_ > 0.0 ? "ETA " + duration_text((end - sim_.time()) / smoothed_speed_)
                                                       : "ETA ...";
@@ -456,9 +483,12 @@ class Runner {
   Config config_;
   RunOptions options_;
   Simulation<D> sim_;
+  Comm comm_;
+  std::int64_t n_particles_ = 0;
+  double max_imbalance_ = 1.0;
   std::filesystem::path dir_;
   OutputMetadata meta_;
-  Schedule history_, snapshot_, checkpoint_;
+  OutputSchedule schedule_;
   HistoryWriter history_writer_{dir_ / "history.csv", history_columns_of(sim_)};
   SnapshotWriter<D> snapshots_;
   std::unique_ptr<SnapshotWriter<D>> cells_;  ///< WLS integration regions
@@ -506,8 +536,24 @@ std::string time_step_note(const Config& config) {
       k, cfl, max_cfl, limit);
 }
 
+namespace {
+/// The WLS method of seed 001 keeps its own node fits and integration regions, which have no
+/// ghost exchange: refused on several ranks (every rank throws; rank 0 prints; exit 2).
+void refuse_wls_on_ranks(const Config& config, const std::string& where) {
+  if (config.method.integration == "wls" && Comm::world().parallel())
+    throw std::invalid_argument(where + ": method.integration = \"wls\" runs on one MPI rank only "
+                                "(docs/parallel.md); run it without mpirun or with -np 1");
+}
+}  // namespace
+
 RunSummary run(const Config& config, const RunOptions& options) {
-  if (config.fem.enabled) return fem::run(config, options);
+  refuse_wls_on_ranks(config, config.source_file);
+  if (config.fem.enabled) {
+    if (Comm::world().parallel())
+      throw std::invalid_argument(config.source_file + ": [fem] runs on one MPI rank only (docs/parallel.md); run "
+                                  "it without mpirun");
+    return fem::run(config, options);
+  }
   switch (config.simulation.dimension) {
     case 1: return run_dim<1>(config, options, nullptr);
     case 2: return run_dim<2>(config, options, nullptr);
@@ -519,12 +565,15 @@ namespace {
 template <int D>
 RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
                        const RunOptions& options) {
-  const CheckpointData<D> data = read_checkpoint<D>(file);
+  const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
-  // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints them.
-  for (const auto& w : config.warnings) std::fprintf(stderr, "cairn: warning: %s\n", w.c_str());
+  refuse_wls_on_ranks(config, file.string());
+  // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints
+  // them (rank 0 alone on several ranks).
+  if (Comm::world().is_root())
+    for (const auto& w : config.warnings) std::fprintf(stderr, "cairn: warning: %s\n", w.c_str());
   return run_dim<D>(config, options, &data);
 }
 }  // namespace
@@ -545,7 +594,11 @@ RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<st
     for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
     all.push_back("output.directory=" + quoted + "\"");
   }
-  if (fem::is_checkpoint(checkpoint)) return fem::restart(checkpoint, all, options);
+  if (fem::is_checkpoint(checkpoint)) {
+    if (Comm::world().parallel())
+      throw std::invalid_argument(checkpoint.string() + ": [fem] runs on one MPI rank only (docs/parallel.md)");
+    return fem::restart(checkpoint, all, options);
+  }
   switch (checkpoint_dimension(checkpoint)) {
     case 1: return restart_dim<1>(checkpoint, all, options);
     case 2: return restart_dim<2>(checkpoint, all, options);

@@ -19,9 +19,13 @@ struct RunSummary {
   double end_time = 0.0;    ///< simulated time reached
   double wall_seconds = 0.0;
   double particle_steps_per_second = 0.0;
-  std::size_t n_particles = 0;
+  std::size_t n_particles = 0;  ///< over all ranks
   std::string item = "particle";          ///< what n_particles counts ("element" for FEM runs)
   std::string xdmf = "particles.xdmf";    ///< the snapshot index in output_directory
+  int ranks = 1;                ///< MPI ranks the run was distributed over
+  int partitions = 0;           ///< domain partitions (start-up and repartitions), several ranks
+  long long migrated = 0;       ///< particles that moved between ranks
+  double max_imbalance = 1.0;   ///< largest particle imbalance seen at a step's start
   std::filesystem::path output_directory;
   std::filesystem::path last_checkpoint;
   /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).

@@ -6,6 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <optional>
+#include <set>
 #include <stdexcept>
 
 #include "cairn/contact/contact.hpp"
@@ -20,27 +23,31 @@ namespace cairn {
 
 namespace {
 
-/// Deterministic parallel sum: fixed chunks, combined in order (independent of thread count).
-template <class T, class Fn>
-T chunked_sum(std::int64_t n, T zero, Fn&& term) {
-  constexpr std::int64_t chunk = 4096;
-  const std::int64_t n_chunks = (n + chunk - 1) / chunk;
-  std::vector<T> partial(static_cast<std::size_t>(n_chunks), zero);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t c = 0; c < n_chunks; ++c) {
-    T s = zero;
-    for (std::int64_t p = c * chunk; p < std::min(n, (c + 1) * chunk); ++p) s += term(p);
-    partial[c] = s;
+/// Exact sums of N terms over p in [0, n): term(p, out) sets out[0..N), every thread adds into
+/// its own accumulators, merged exactly, so the result does not depend on the thread count or,
+/// summed across ranks, on the partition (parallel/exact_sum.hpp).
+template <int N, class Fn>
+std::array<ExactSum, N> exact_sums(std::int64_t n, Fn&& term) {
+  std::array<ExactSum, N> total;
+#pragma omp parallel
+  {
+    std::array<ExactSum, N> local;
+    std::array<double, N> values{};
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
+      term(p, values);
+      for (int k = 0; k < N; ++k) local[k].add(values[k]);
+    }
+#pragma omp critical(cairn_exact_sums)
+    for (int k = 0; k < N; ++k) total[k] += local[k];
   }
-  T total = zero;
-  for (const auto& s : partial) total += s;
   return total;
 }
 
 }  // namespace
 
 template <int D>
-Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.simulation.mode) {
+Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(config), mode_(config.simulation.mode) {
   if (config_.simulation.threads > 0) omp_set_num_threads(config_.simulation.threads);
   for (const auto& mc : config_.materials) materials_.push_back(make_material(mc));
   ShapeContext ctx{config_.method, D};
@@ -66,7 +73,7 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
   for (const auto& m : materials_) material_density_.push_back(m->density());
   material_in_use_.assign(materials_.size(), 0);
   for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
-  if (config_.thermal.conduction) {
+  if (config_.thermal.conduction) {  // on the whole grid here; windows in allocate_nodes
     std::vector<double> k, cp;
     for (const auto& mc : config_.materials) {
       k.push_back(mc.has("conductivity") ? mc.number("conductivity") : 0.0);
@@ -82,25 +89,14 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     // Multimaterial mode: one field per material or body, side by side (contact/contact.hpp).
     contact_ = std::make_unique<Contact<D>>(config_, grid_, particles_, small_mass_);
     n_fields_ = contact_->n_fields();
-    contact_dv_.assign(n_slots(), Vec<D>::Zero());
-    contact_impulse_.assign(n_slots(), Vec<D>::Zero());
-    totals_.mass.assign(grid_.n_nodes(), 0.0);
-    totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
-    field_offset_.resize(particles_.n());
-    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
   }
   // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
   // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
-  const bool node_scratch = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
-  nodes_.resize(n_slots(), node_scratch);
-  if (node_scratch) {
-    grid_term_.assign(n_slots(), Vec<D>::Zero());
-    grid_proj_.assign(n_slots(), Vec<D>::Zero());
-  }
+  node_scratch_ = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
+  // Conditions and tractions select their nodes and faces on the whole grid and every particle,
+  // so that a selection holding none is refused the same way on any number of ranks.
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
-  if (conditions_.empty() && velocity_conditions_.empty())
-    std::vector<Vec<D>>().swap(nodes_.reaction);  // nothing records reactions
   tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
 
   if (config_.method.integration == "wls") {
@@ -142,9 +138,24 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
                                                                   config_.constants));
     body_force_constant_ = body_force_[0]->is_constant();
     if (body_force_constant_) body_force_value_ = (*body_force_[0])(Vec<D>::Zero(), Vec<D>::Zero(), 0.0);
-    node_body_force_.assign(n_slots(), Vec<D>::Zero());
   }
   check_run_length<D>(*this);
+  if (comm.parallel()) {
+    // Each rank keeps the particles of its box and a window of the grid (docs/parallel.md).
+    distribution_ = Distribution<D>(comm, whole_);
+    // Every rank created every particle (the same setup, so tractions and conditions saw them
+    // all); each keeps an equal slab of them and the partition sends each to its owner.
+    const auto n = particles_.n(), rank = static_cast<std::size_t>(comm.rank()),
+               ranks = static_cast<std::size_t>(comm.size());
+    std::vector<std::int32_t> slab(n * (rank + 1) / ranks - n * rank / ranks);
+    std::iota(slab.begin(), slab.end(), static_cast<std::int32_t>(n * rank / ranks));
+    reorder_particles(particles_, slab);
+    distribution_.partition(particles_);
+    velocity_conditions_.set_comm(comm);
+    reach_ = std::max(1, shape_->ghost_layers());
+    grid_ = distribution_.window(whole_, reach_);
+  }
+  allocate_nodes();
   if (wls_) {
     // The initial node fields and integration regions, so that output at t = 0 shows them.
     wls_->build_stencils(grid_, particles_);
@@ -152,6 +163,134 @@ Simulation<D>::Simulation(const Config& config) : config_(config), mode_(config.
     wls_->collect(grid_, particles_, material_density_, body_force_.empty() ? nullptr : &body_acceleration_,
                   nodes_, body_force_.empty() ? nullptr : &node_body_force_);
   }
+}
+
+template <int D>
+void Simulation<D>::allocate_nodes() {
+  nodes_.resize(n_slots(), node_scratch_);
+  if (node_scratch_) {
+    grid_term_.assign(n_slots(), Vec<D>::Zero());
+    grid_proj_.assign(n_slots(), Vec<D>::Zero());
+  }
+  if (contact_) {
+    contact_->grid_changed();
+    contact_dv_.assign(n_slots(), Vec<D>::Zero());
+    contact_impulse_.assign(n_slots(), Vec<D>::Zero());
+    totals_.mass.assign(grid_.n_nodes(), 0.0);
+    totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
+    field_offset_.resize(particles_.n());
+    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+  }
+  if (!grid_.is_whole()) {
+    conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
+    VelocityConditions<D> window_conditions(config_, grid_, conditions_, false);
+    window_conditions.take_state(std::move(velocity_conditions_));
+    velocity_conditions_ = std::move(window_conditions);
+  }
+  if (conditions_.empty() && velocity_conditions_.empty())
+    std::vector<Vec<D>>().swap(nodes_.reaction);  // nothing records reactions
+  if (conduction_) conduction_->grid_changed();
+  if (!body_force_.empty()) node_body_force_.assign(n_slots(), Vec<D>::Zero());
+}
+
+template <int D>
+void Simulation<D>::set_window(const Grid<D>& window) {
+  bool same = window.n_nodes() == grid_.n_nodes();
+  for (int a = 0; a < D && same; ++a)
+    same = window.first_node(a) == grid_.first_node(a) && window.stored_nodes(a) == grid_.stored_nodes(a) &&
+           window.own_lo()[a] == grid_.own_lo()[a] && window.own_hi()[a] == grid_.own_hi()[a];
+  if (same) return;
+  grid_ = window;
+  allocate_nodes();
+}
+
+template <int D>
+template <class Fn>
+void Simulation<D>::collectively(Fn&& fn) {
+  if (!distributed()) {
+    fn();
+    return;
+  }
+  const Comm& comm = distribution_.comm();
+  constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  std::int64_t key = none;
+  std::string message, quantity;
+  try {
+    fn();
+  } catch (const SimulationFailure& f) {
+    // Name the particle by its id, the number a serial run gives it.
+    const std::int64_t p = f.particle();
+    key = p >= 0 && static_cast<std::size_t>(p) < particles_.n() ? particles_.id[static_cast<std::size_t>(p)] : -1;
+    message = f.what();
+    quantity = f.quantity();
+    if (p >= 0) {
+      const std::string local = "particle " + std::to_string(p);
+      if (const auto at = message.find(local); at != std::string::npos)
+        message.replace(at, local.size(), "particle " + std::to_string(key));
+    }
+  }
+  const std::int64_t first = comm.min(key);
+  if (first == none) return;
+  const auto root = static_cast<int>(comm.min(key == first ? std::int64_t{comm.rank()} : std::int64_t{comm.size()}));
+  comm.broadcast(message, root);
+  comm.broadcast(quantity, root);
+  distribution_.drop_ghosts(particles_);
+  throw SimulationFailure(first, quantity, message);
+}
+
+template <int D>
+std::int64_t Simulation<D>::total_particles() const {
+  return distribution_.comm().sum(static_cast<std::int64_t>(n_owned()));
+}
+
+template <int D>
+void Simulation<D>::set_particles(Particles<D> particles) {
+  particles_ = std::move(particles);
+  if (distributed()) {
+    distribution_.partition(particles_);
+  } else if (!std::is_sorted(particles_.id.begin(), particles_.id.end())) {
+    // A checkpoint of a distributed run lists particles rank after rank: back to id order.
+    std::vector<std::int32_t> order(particles_.n());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::int32_t a, std::int32_t b) { return particles_.id[a] < particles_.id[b]; });
+    reorder_particles(particles_, order);
+  }
+  if (contact_) {
+    field_offset_.resize(particles_.n());
+    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+  }
+}
+
+template <int D>
+std::vector<std::string> Simulation<D>::take_notes() {
+  std::vector<std::string> notes = velocity_conditions_.take_notes();
+  if (!distributed()) return notes;
+  const Comm& comm = distribution_.comm();
+  if (!comm.any(!notes.empty())) return {};
+  // Rank 0 prints: every rank sends its notes there; a conflict seen by several ranks (or at
+  // several nodes) is said once, by the pair of conditions it names.
+  Comm::Buffers send(static_cast<std::size_t>(comm.size()));
+  for (const auto& note : notes) {
+    send[0].insert(send[0].end(), note.begin(), note.end());
+    send[0].push_back('\0');
+  }
+  const Comm::Buffers recv = comm.all_to_all(send);
+  std::vector<std::string> out;
+  if (!comm.is_root()) return out;
+  for (const auto& buffer : recv) {
+    std::string text;
+    for (char c : buffer) {
+      if (c != '\0') {
+        text.push_back(c);
+        continue;
+      }
+      const std::string pair = text.substr(0, text.find(" both set"));
+      if (reported_pairs_.insert(pair).second) out.push_back(text);
+      text.clear();
+    }
+  }
+  return out;
 }
 
 template <int D>
@@ -176,13 +315,15 @@ void Simulation<D>::setup_grid() {
   check_node_count(config_, cells, wraps, ghost, velocity_fields(config_));
   for (int a = 0; a < D; ++a) n_cells[a] = static_cast<int>(cells[a]);
   grid_ = Grid<D>(origin, n_cells, h, ghost, periodic);
+  whole_ = grid_;
 }
 
 template <int D>
 double Simulation<D>::max_signal_speed() const {
   // Materials whose wave speed does not depend on F are asked once (if they have particles);
-  // max |V| is sqrt(max |V|^2), the same number.
-  const auto n = static_cast<std::int64_t>(particles_.n());
+  // max |V| is sqrt(max |V|^2), the same number. Maxima over the owned particles, then over the
+  // ranks (order-independent).
+  const auto n = static_cast<std::int64_t>(n_owned());
   const auto n_materials = static_cast<std::int32_t>(materials_.size());
   double c_max = 0.0;
   std::vector<char> varies(materials_.size(), 0);
@@ -197,7 +338,9 @@ double Simulation<D>::max_signal_speed() const {
     if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
     v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
   }
-  return c_max + std::sqrt(v2_max);
+  double both[2] = {c_max, v2_max};
+  distribution_.comm().max(both, 2);
+  return both[0] + std::sqrt(both[1]);
 }
 
 template <int D>
@@ -260,6 +403,21 @@ void Simulation<D>::step(double dt) {
   const int k = config_.method.order;
   step_dt_ = dt;
 
+  try {
+    step_stages(dt, need, fmpm_velocities, k, lap);
+  } catch (...) {
+    distribution_.drop_ghosts(particles_);  // a failed step leaves the owned particles only
+    throw;
+  }
+  distribution_.drop_ghosts(particles_);
+  velocity_conditions_.finish_step();
+  time_ += dt;
+  ++step_;
+}
+
+template <int D>
+template <class Lap>
+void Simulation<D>::step_stages(double dt, FullMass need, bool fmpm_velocities, int k, Lap& lap) {
   build_stencils();
   lap(0);
   const bool stress_first = timing_ == Timing::usf || timing_ == Timing::usavg || timing_ == Timing::usavg_plus;
@@ -271,6 +429,7 @@ void Simulation<D>::step(double dt) {
     stress_velocity_from_momentum(nodes_.momentum, fmpm_velocities);
     lap(3);
     update_stresses(nodes_.velocity_work, timing_ == Timing::usf ? dt : 0.5 * dt);
+    refresh_ghosts(particles_.kirchhoff_stress);  // the forces below read the ghosts' stresses
     lap(5);
     particles_to_grid(false, true);
   } else {
@@ -307,6 +466,7 @@ void Simulation<D>::step(double dt) {
     case Timing::usl_plus:
     case Timing::usavg_plus:
       // Re-extrapolate the updated particle momenta before the last stress update.
+      refresh_ghosts(particles_.velocity);
       reextrapolate_momentum();
       lap(1);
       stress_velocity_from_momentum(grid_term_, fmpm_velocities);
@@ -315,10 +475,12 @@ void Simulation<D>::step(double dt) {
       break;
   }
   lap(5);
-  if (conduction_) conduction_->step(cache_, particles_, dt);
-  velocity_conditions_.finish_step();
-  time_ += dt;
-  ++step_;
+  if (conduction_) {
+    refresh_ghosts(particles_.temperature, particles_.has_temperature ? 1 : 0);
+    std::function<void(std::vector<Vec<D>>&)> share_flux;
+    if (distributed()) share_flux = [this](std::vector<Vec<D>>& flux) { refresh_ghosts(flux); };
+    conduction_->step(cache_, particles_, dt, share_flux);
+  }
 }
 
 template <int D>
@@ -373,8 +535,76 @@ void Simulation<D>::wls_step(double dt) {
 
 template <int D>
 void Simulation<D>::build_stencils() {
-  shape_->build(grid_, particles_, cache_);
+  if (distributed()) {
+    distribute_and_build();
+  } else {
+    shape_->build(grid_, particles_, cache_);
+  }
   colour_blocks(grid_, particles_, cache_);
+}
+
+template <int D>
+void Simulation<D>::distribute_and_build() {
+  const Comm& comm = distribution_.comm();
+  // Particles that crossed into another box move there; the imbalance is measured on the
+  // result, and beyond the threshold the boxes are bisected anew (docs/parallel.md).
+  distribution_.migrate(particles_);
+  imbalance_ = distribution_.imbalance(particles_.n());
+  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) distribution_.partition(particles_);
+  for (;;) {
+    distribution_.add_ghosts(particles_, reach_);
+    set_window(distribution_.window(whole_, reach_));
+    const std::size_t n_own = distribution_.n_owned();
+    std::int64_t failed_at = -1;
+    std::optional<SimulationFailure> failure;
+    try {
+      shape_->build(grid_, particles_, cache_);
+    } catch (const SimulationFailure& f) {
+      failure = f;
+      failed_at = f.particle();
+    }
+    // The window and ghost band must cover the stencils' reach over all ranks' particles; a
+    // wider reach (CPDI domains stretch) widens them and the step starts over.
+    std::int64_t reach[2 * D];
+    for (int a = 0; a < D; ++a) {
+      reach[a] = cache_.reach_lo[a];
+      reach[D + a] = cache_.reach_hi[a];
+    }
+    comm.max(reach, 2 * D);
+    std::int64_t needed = 0;
+    for (auto r : reach) needed = std::max(needed, r);
+    if (needed > reach_) {
+      reach_ = static_cast<int>(needed);
+      distribution_.drop_ghosts(particles_);
+      continue;
+    }
+    // With the reach covered, an owned particle whose stencil leaves the window leaves the
+    // stored grid: the failure of a serial run. (Owned particles come first, so the lowest
+    // failing index is an owned one whenever there is one.)
+    const bool owned_failed = failure && failed_at < static_cast<std::int64_t>(n_own);
+    if (comm.any(owned_failed)) collectively([&] {
+        if (owned_failed) throw *failure;
+      });
+    // Only a ghost failed while the reach fits: a sizing error; widen and retry (bounded).
+    if (comm.any(failure.has_value())) {
+      if (reach_ > 64) throw std::runtime_error("distributed run: ghost stencils do not fit the window");
+      ++reach_;
+      distribution_.drop_ghosts(particles_);
+      continue;
+    }
+    for (int a = 0; a < D; ++a) {
+      cache_.reach_lo[a] = static_cast<int>(reach[a]);
+      cache_.reach_hi[a] = static_cast<int>(reach[D + a]);
+    }
+    break;
+  }
+  cache_.n_owned = distribution_.n_owned();
+  cache_.id_order = distribution_.id_order();
+  tractions_.localise(particles_, distribution_.n_owned());
+  if (contact_) {
+    field_offset_.resize(particles_.n());
+    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+  }
 }
 
 template <int D>
@@ -462,8 +692,10 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   else extrapolate(std::false_type{});
   // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
   if (forces)
-    tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
-                          contact_ ? &field_offset_ : nullptr);
+    collectively([&] {
+      tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
+                            contact_ ? &field_offset_ : nullptr);
+    });
   if (mass_and_momentum && contact_) {
     // Multimaterial: contact nodes, normals and separations of this step, then the first
     // correction p^a = p^a0 + dp^a kept as dv^a (seed 004 Eq. 26).
@@ -513,28 +745,41 @@ void Simulation<D>::update_grid(double dt) {
   });
   // Second contact correction, on the updated momenta: dp^a+ / dt is the contact force and the
   // acceleration is (v^a+ - v^a) / dt with the corrected v^a (seed 004 Eq. 30-34).
-  if (contact_)
+  if (contact_) {
     contact_->correct(nodes_.mass, nodes_.velocity_new, false, Contact<D>::Pass::updated, time_, dt, nullptr);
+    contact_->reduce(distribution_.comm());
+  }
   for (int f = 0; f < n_fields_; ++f) {
     const std::int32_t off = f * grid_.n_nodes();
     conditions_.apply_step(nodes_, dt, off);
     velocity_conditions_.apply_step(nodes_, dt, config_.boundary.acceleration == BoundaryAcceleration::zero, off,
                                     f == 0);
   }
+  velocity_conditions_.reduce_reactions();
 
-  // External work of this step: body forces, tractions and reactions at the mean grid velocity.
+  // External work of this step: body forces, tractions and reactions at the mean grid velocity,
+  // summed exactly over the nodes (traction faces) each rank owns and over the ranks.
   const bool has_body_force = !body_force_.empty();
-  if (!tractions_.empty())
-    external_work_ += 0.5 * dt * (tractions_.power(nodes_.velocity, contact_ ? &field_offset_ : nullptr) +
-                                  tractions_.power(nodes_.velocity_new, contact_ ? &field_offset_ : nullptr));
-  if (has_body_force || !conditions_.empty() || !velocity_conditions_.empty()) {
-    external_work_ += dt * chunked_sum<double>(n_slots(), 0.0, [&](std::int64_t i) {
-      const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
-      double w = nodes_.reaction.empty() ? 0.0 : nodes_.reaction[i].dot(v_mean);
-      if (has_body_force) w += node_body_force_[i].dot(v_mean);
-      return w;
-    });
+  std::array<ExactSum, 3> work;
+  if (!tractions_.empty()) {
+    work[0] = tractions_.power(nodes_.velocity, contact_ ? &field_offset_ : nullptr);
+    work[1] = tractions_.power(nodes_.velocity_new, contact_ ? &field_offset_ : nullptr);
   }
+  const bool node_work = has_body_force || !conditions_.empty() || !velocity_conditions_.empty();
+  if (node_work) {
+    const std::int32_t nn = grid_.n_nodes();
+    const bool whole = grid_.is_whole();
+    work[2] = exact_sums<1>(n_slots(), [&](std::int64_t i, std::array<double, 1>& w) {
+      w[0] = 0.0;
+      if (!whole && !grid_.owns(static_cast<std::int32_t>(i % nn))) return;
+      const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);
+      if (!nodes_.reaction.empty()) w[0] += nodes_.reaction[i].dot(v_mean);
+      if (has_body_force) w[0] += node_body_force_[i].dot(v_mean);
+    })[0];
+  }
+  sum_across(distribution_.comm(), work.data(), 3);
+  if (!tractions_.empty()) external_work_ += 0.5 * dt * (work[0].value() + work[1].value());
+  if (node_work || distributed()) external_work_ += dt * work[2].value();
 }
 
 template <int D>
@@ -549,6 +794,7 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
     });
     particle_vec_[p] = Vec<D>(u);
   });
+  refresh_ghosts(particle_vec_);  // the scatter below reads the ghosts' U_p too
   for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
   scatter(cache_, [&](std::int32_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
@@ -740,7 +986,9 @@ void Simulation<D>::update_particles(double dt) {
       return dissipated;
     });
   };
-  dissipated_energy_ += use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
+  ExactSum dissipated = use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
+  sum_across(distribution_.comm(), &dissipated, 1);
+  dissipated_energy_ += dissipated.value();
 }
 
 template <int D>
@@ -799,7 +1047,9 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
       }
     }
   });
-  if (first_bad >= 0) particle_failure(first_bad, what);
+  collectively([&] {
+    if (first_bad >= 0) particle_failure(first_bad, what);
+  });
 }
 
 template <int D>
@@ -855,28 +1105,34 @@ NodeField<D> Simulation<D>::grid_totals() const {
 
 template <int D>
 Totals Simulation<D>::totals() const {
+  // Exact sums over the owned particles and the ranks: the same totals for any partition.
   const auto& P = particles_;
-  const auto n = static_cast<std::int64_t>(P.n());
-  Totals t;
-  t.kinetic_energy = chunked_sum<double>(n, 0.0, [&](std::int64_t p) {
-    return 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
-  });
-  t.strain_energy = chunked_sum<double>(n, 0.0, [&](std::int64_t p) {
+  const auto n = static_cast<std::int64_t>(n_owned());
+  std::array<ExactSum, 7> sums = exact_sums<7>(n, [&](std::int64_t p, std::array<double, 7>& v) {
+    v[0] = 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
     const double* state = P.n_state_per_particle ? &P.state[p * static_cast<std::size_t>(P.n_state_per_particle)] : nullptr;
-    return P.volume0[p] * materials_[P.material[p]]->internal_energy_density(P.deformation_gradient[p], state);
+    v[1] = P.volume0[p] * materials_[P.material[p]]->internal_energy_density(P.deformation_gradient[p], state);
+    const Vec3 momentum = to3<D>(P.mass[p] * P.velocity[p]);
+    v[2] = momentum[0];
+    v[3] = momentum[1];
+    v[4] = momentum[2];
+    v[5] = P.mass[p];
+    v[6] = P.has_temperature ? P.mass[p] * P.temperature[p] : 0.0;
   });
-  t.momentum = chunked_sum<Vec3>(n, Vec3::Zero(), [&](std::int64_t p) {
-    return Vec3(to3<D>(P.mass[p] * P.velocity[p]));
-  });
-  t.mass = chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p]; });
-  if (P.has_temperature)
-    t.mean_temperature =
-        chunked_sum<double>(n, 0.0, [&](std::int64_t p) { return P.mass[p] * P.temperature[p]; }) / t.mass;
+  const Comm& comm = distribution_.comm();
+  sum_across(comm, sums.data(), 7);
+  Totals t;
+  t.kinetic_energy = sums[0].value();
+  t.strain_energy = sums[1].value();
+  t.momentum = Vec3(sums[2].value(), sums[3].value(), sums[4].value());
+  t.mass = sums[5].value();
+  if (P.has_temperature) t.mean_temperature = sums[6].value() / t.mass;
   double p_max = -std::numeric_limits<double>::infinity();
 #pragma omp parallel for reduction(max : p_max)
   for (std::int64_t p = 0; p < n; ++p)
     p_max = std::max(p_max, -P.kirchhoff_stress[p].trace() / (3.0 * P.deformation_gradient[p].determinant()));
-  t.max_pressure = n > 0 ? p_max : 0.0;
+  p_max = comm.max(p_max);
+  t.max_pressure = total_particles() > 0 ? p_max : 0.0;
   return t;
 }
 

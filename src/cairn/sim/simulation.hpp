@@ -5,6 +5,7 @@
 
 #include <array>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,8 @@
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
 #include "cairn/materials/material.hpp"
+#include "cairn/parallel/comm.hpp"
+#include "cairn/parallel/distribution.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/schemes/scheme.hpp"
 #include "cairn/shapes/shape_family.hpp"
@@ -44,7 +47,10 @@ class Simulation {
  public:
   /// Build grid, materials and particles from a validated config. Throws std::invalid_argument
   /// for inputs that pass key validation but cannot be set up (e.g. a body with no particle).
-  explicit Simulation(const Config& config);
+  /// With a `comm` of several ranks the run is distributed (docs/parallel.md): every rank sets
+  /// up the whole run, then keeps its share of the particles and a window of the grid; the
+  /// constructor and step() are then collective.
+  explicit Simulation(const Config& config, const Comm& comm = Comm::serial());
   ~Simulation();
 
   // ---- one explicit step (seed 000 Table 1) -------------------------------------------------
@@ -73,7 +79,20 @@ class Simulation {
 
   // ---- state ----------------------------------------------------------------------------------
   [[nodiscard]] const Config& config() const { return config_; }
+  /// The grid this rank stores: the whole grid in a serial run, a window of it on a rank of a
+  /// distributed run (Grid::window).
   [[nodiscard]] const Grid<D>& grid() const { return grid_; }
+  /// The ranks of the run and this rank's share (docs/parallel.md).
+  [[nodiscard]] const Comm& comm() const { return distribution_.comm(); }
+  [[nodiscard]] const Distribution<D>& distribution() const { return distribution_; }
+  /// Largest particle count of a rank over the mean count at the start of the last step (1 on
+  /// one rank).
+  [[nodiscard]] double imbalance() const { return imbalance_; }
+  /// Particles of all ranks (collective on several ranks).
+  [[nodiscard]] std::int64_t total_particles() const;
+  /// Replace the particles with `particles` (a restart: on several ranks, any share of the
+  /// checkpoint's particles per rank) and redistribute them (collective).
+  void set_particles(Particles<D> particles);
   /// Node fields; in multimaterial mode field f of node i is entry f * n_nodes + i.
   [[nodiscard]] const NodeField<D>& nodes() const { return nodes_; }
   /// The WLS method's state (method.integration = "wls", docs/wls.md), or null.
@@ -110,11 +129,34 @@ class Simulation {
   [[nodiscard]] const VelocityConditions<D>& velocity_conditions() const { return velocity_conditions_; }
   [[nodiscard]] VelocityConditions<D>& velocity_conditions() { return velocity_conditions_; }
   [[nodiscard]] const Tractions<D>& tractions() const { return tractions_; }
-  /// Notes raised by the step since the last call (e.g. two conditions on one node), each once.
-  std::vector<std::string> take_notes() { return velocity_conditions_.take_notes(); }
+  /// Notes raised by the step since the last call (e.g. two conditions on one node), each once;
+  /// on several ranks gathered by rank 0 (collective), empty on the others.
+  std::vector<std::string> take_notes();
 
  private:
   void setup_grid();
+  /// Size every node-indexed structure for grid_ (the setup, and a distributed run's windows).
+  void allocate_nodes();
+  /// Store `window` as grid_ when it differs (a distributed run), reallocating the node arrays.
+  void set_window(const Grid<D>& window);
+  /// A distributed step's start: imbalance, repartition, migration; then ghosts, window and
+  /// stencils until the stencils fit the window.
+  void distribute_and_build();
+  /// The stages of step() after its set-up (ghosts are dropped by step() however they end).
+  template <class Lap>
+  void step_stages(double dt, FullMass need, bool fmpm_velocities, int k, Lap& lap);
+  /// Run `fn`; if it throws a SimulationFailure on any rank, throw the one of the lowest
+  /// particle id on every rank, naming the particle by id (collective on several ranks).
+  template <class Fn>
+  void collectively(Fn&& fn);
+  /// A distributed run: owners send the ghost copies the current values of a per-particle array.
+  template <class T>
+  void refresh_ghosts(std::vector<T>& values, int width = 1) {
+    distribution_.refresh(values, width);
+  }
+  [[nodiscard]] bool distributed() const { return distribution_.active(); }
+  /// Particles this rank updates: all local ones outside a step, the owned ones during it.
+  [[nodiscard]] std::size_t n_owned() const { return distributed() ? distribution_.n_owned() : particles_.n(); }
   void compute_body_forces();
   /// The material's stress update of particle p into its stored stress (plane stress included).
   void update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
@@ -142,7 +184,13 @@ class Simulation {
 
   Config config_;
   Mode mode_;
-  Grid<D> grid_;
+  Grid<D> whole_;  ///< the whole grid (geometry)
+  Grid<D> grid_;   ///< the stored grid: whole_, or this rank's window of it
+  Distribution<D> distribution_;
+  int reach_ = 1;             ///< stencil reach the window and ghost band are sized for
+  double imbalance_ = 1.0;
+  std::set<std::string> reported_pairs_;  ///< rank 0 of a distributed run: conflicts noted
+  bool node_scratch_ = false;  ///< the step uses velocity_full / velocity_work and grid_term_
   NodeField<D> nodes_;
   std::vector<Vec<D>> node_body_force_;  ///< S^T M B part of f, for the external-work tally
   Particles<D> particles_;

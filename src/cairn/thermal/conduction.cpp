@@ -11,18 +11,25 @@ Conduction<D>::Conduction(const ThermalConfig& config, const Grid<D>& grid,
                           std::vector<double> conductivity, std::vector<double> heat_capacity,
                           double thickness)
     : config_(config), grid_(&grid), k_(std::move(conductivity)), cp_(std::move(heat_capacity)) {
+  for (int f = 0; f < 2 * D; ++f) {
+    face_area_[f] = D == 3 ? 1.0 : thickness;  // 2D: per unit thickness; 1D: cross-section
+    for (int b = 0; b < D; ++b)
+      if (b != f / 2) face_area_[f] *= grid.cell_size()[b];
+  }
+  grid_changed();
+}
+
+template <int D>
+void Conduction<D>::grid_changed() {
+  const Grid<D>& grid = *grid_;
   const auto n = grid.n_nodes();
   capacity_.assign(n, 0.0);
   temperature_.assign(n, 0.0);
   temperature_new_.assign(n, 0.0);
   held_.assign(n, 0.0);
   heat_.assign(n, 0.0);
-  for (int f = 0; f < 2 * D; ++f) {
-    face_area_[f] = D == 3 ? 1.0 : thickness;  // 2D: per unit thickness; 1D: cross-section
-    for (int b = 0; b < D; ++b)
-      if (b != f / 2) face_area_[f] *= grid.cell_size()[b];
-  }
   flux_.assign(0, Vec<D>::Zero());
+  face_nodes_.clear();
   for (std::int32_t i = 0; i < n; ++i) {
     const IVec<D> j = grid.multi_index(i);
     for (int f = 0; f < 2 * D; ++f) {
@@ -47,7 +54,8 @@ double Conduction<D>::stable_dt(const Particles<D>& particles, const std::vector
 }
 
 template <int D>
-void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double dt) {
+void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double dt,
+                         const std::function<void(std::vector<Vec<D>>&)>& share_flux) {
   const auto n = grid_->n_nodes();
   for_each_node(n, [&](std::int32_t i) {
     capacity_[i] = 0.0;
@@ -78,6 +86,7 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
     stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) { grad += held_[node] * G; });
     flux_[p] = P.deformation_gradient[p].determinant() * P.volume0[p] * k_[P.material[p]] * grad;
   });
+  if (share_flux) share_flux(flux_);
   scatter(cache, [&](std::int32_t p, const auto& stencil) {
     stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) { heat_[node] -= flux_[p].dot(G); });
   });

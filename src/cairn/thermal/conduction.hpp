@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
@@ -30,8 +31,13 @@ class Conduction {
   Conduction(const ThermalConfig& config, const Grid<D>& grid, std::vector<double> conductivity,
              std::vector<double> heat_capacity, double thickness);
 
+  /// The grid passed to the constructor now stores another window (a distributed run).
+  void grid_changed();
   /// One explicit conduction step over the transfer cache of the current mechanical step.
-  void step(const TransferCache<D>& cache, Particles<D>& particles, double dt);
+  /// `share_flux` (a distributed run) gives the ghost particles their owners' heat fluxes
+  /// between the gather that computes them and the scatter that reads them.
+  void step(const TransferCache<D>& cache, Particles<D>& particles, double dt,
+            const std::function<void(std::vector<Vec<D>>&)>& share_flux = {});
   /// Largest stable time step for the particles' materials (infinity when nothing conducts).
   [[nodiscard]] double stable_dt(const Particles<D>& particles, const std::vector<double>& density) const;
 

@@ -28,6 +28,13 @@ template <int D>
 struct TransferCache {
   StencilLayout layout = StencilLayout::list;
   std::size_t n = 0;                 ///< particles
+  /// Particles [0, n_owned) are updated by gathers; a distributed run's ghost copies of other
+  /// ranks' particles follow them and are only scattered (docs/parallel.md). n_owned = n unless
+  /// the simulation says otherwise after the build.
+  std::size_t n_owned = 0;
+  /// A distributed run: every particle in increasing id (the serial order), for the colouring's
+  /// sort and contact's point clouds. Empty: storage order is id order.
+  std::vector<std::int32_t> id_order;
 
   // ---- list layout ----
   int stride = 0;                    ///< stencil slots per particle (the family's maximum)
@@ -57,7 +64,10 @@ struct TransferCache {
 
   /// List layout for n particles with `slots` stencil entries each (no-op when already sized).
   void reserve(std::size_t n_particles, int slots) {
-    if (layout == StencilLayout::list && stride == slots && n == n_particles) return;
+    if (layout == StencilLayout::list && stride == slots && n == n_particles) {
+      n_owned = n;
+      return;
+    }
     release_tensor();
     layout = StencilLayout::list;
     n = n_particles;
@@ -71,7 +81,10 @@ struct TransferCache {
 
   /// Tensor layout for n particles with `nodes_per_axis` nodes per axis.
   void reserve_tensor(std::size_t n_particles, int nodes_per_axis) {
-    if (layout == StencilLayout::tensor && width == nodes_per_axis && n == n_particles) return;
+    if (layout == StencilLayout::tensor && width == nodes_per_axis && n == n_particles) {
+      n_owned = n;
+      return;
+    }
     release_list();
     layout = StencilLayout::tensor;
     n = n_particles;
@@ -83,6 +96,7 @@ struct TransferCache {
 
  private:
   void resize_common() {
+    n_owned = n;
     block_of.assign(n, 0);
     order.assign(n, 0);
   }

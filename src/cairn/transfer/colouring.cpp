@@ -52,8 +52,14 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
   for (std::int64_t p = 0; p < n; ++p) ++cache.block_begin[cache.block_of[p] + 1];
   for (int b = 0; b < total_blocks; ++b) cache.block_begin[b + 1] += cache.block_begin[b];
   cache.cursor.assign(cache.block_begin.begin(), cache.block_begin.end() - 1);
-  for (std::int64_t p = 0; p < n; ++p)
-    cache.order[cache.cursor[cache.block_of[p]]++] = static_cast<std::int32_t>(p);
+  // Within a block, particles in increasing id (storage order, or the id order of a distributed
+  // run's owned and ghost particles), so that every node adds them in the serial order.
+  if (cache.id_order.empty()) {
+    for (std::int64_t p = 0; p < n; ++p)
+      cache.order[cache.cursor[cache.block_of[p]]++] = static_cast<std::int32_t>(p);
+  } else {
+    for (const std::int32_t p : cache.id_order) cache.order[cache.cursor[cache.block_of[p]]++] = p;
+  }
 
   cache.colour_blocks.resize(total_colours);
   for (auto& list : cache.colour_blocks) list.clear();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 
@@ -258,11 +259,12 @@ void scatter(const TransferCache<D>& cache, Fn&& fn) {
 /// down by another process on its core (chunks are handed out dynamically).
 inline constexpr std::int64_t gather_chunk = 512;
 
-/// Gather: calls fn(p, stencil) for every particle, in parallel over chunks of particles.
+/// Gather: calls fn(p, stencil) for every owned particle (cache.n_owned), in parallel over
+/// chunks of particles.
 template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
   with_stencils(cache, [&](auto stencil_of) {
-    const auto n = static_cast<std::int64_t>(cache.n);
+    const auto n = static_cast<std::int64_t>(cache.n_owned);
     const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t c = 0; c < n_chunks; ++c) {
@@ -272,24 +274,27 @@ void gather(const TransferCache<D>& cache, Fn&& fn) {
   });
 }
 
-/// Gather that also returns sum_p fn(p, stencil): a running sum within each chunk, the chunks'
-/// sums added in chunk order, so the total is the same for any thread count.
+/// Gather over the owned particles that also returns sum_p fn(p, stencil), summed exactly
+/// (parallel/exact_sum.hpp): the same for any thread count and any distribution of the
+/// particles over ranks (this rank's part; the caller sums across ranks).
 template <int D, class Fn>
-double gather_sum(const TransferCache<D>& cache, Fn&& fn) {
-  const auto n = static_cast<std::int64_t>(cache.n);
+ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
+  const auto n = static_cast<std::int64_t>(cache.n_owned);
   const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
-  std::vector<double> partial(static_cast<std::size_t>(n_chunks), 0.0);
+  ExactSum total;
   with_stencils(cache, [&](auto stencil_of) {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < n_chunks; ++c) {
-      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
-      double sum = 0.0;
-      for (std::int64_t p = c * gather_chunk; p < end; ++p) sum += fn(p, stencil_of(static_cast<std::size_t>(p)));
-      partial[static_cast<std::size_t>(c)] = sum;
+#pragma omp parallel
+    {
+      ExactSum sum;
+#pragma omp for schedule(dynamic, 1)
+      for (std::int64_t c = 0; c < n_chunks; ++c) {
+        const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
+        for (std::int64_t p = c * gather_chunk; p < end; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
+      }
+#pragma omp critical(cairn_gather_sum)
+      total += sum;
     }
   });
-  double total = 0.0;
-  for (double s : partial) total += s;
   return total;
 }
 

@@ -1,0 +1,109 @@
+// One rank's share of a distributed run (docs/parallel.md): its box of cells, the particles it
+// owns, the ghost copies of other ranks' particles it needs, and the exchanges between them.
+//
+// Ghost particles, not node sums. Each rank adds, at every node it reads, the contributions of
+// its own particles and of copies ("ghosts") of every other particle whose stencil reaches that
+// node, in increasing particle id within each colouring block: the order a serial run uses. So
+// node values are not summed across ranks at all; they come out bit-identical to the serial
+// run's. The price is that the ghosts' per-particle values the step scatters must be current:
+// the owners send them (refresh) after every gather whose result is scattered again (full-mass
+// sweeps, the stresses of USF, the velocities of USL+, the heat fluxes of conduction).
+//
+// Widths, for stencils reaching r cells beyond the particle's cell (the shape family's reach, at
+// most): a rank reads nodes up to R = r + 1 beyond its box (the +1: traction faces of point
+// families sit up to a cell from their particle). A node there receives from particles up to
+// R + r + 2 cells away, hence ghosts come from a band of B = 2 r + 3 cells around the box, and
+// the rank stores the nodes those ghosts reach: a window of W = B + r + 2 nodes beyond the box.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/parallel/comm.hpp"
+#include "cairn/parallel/decomposition.hpp"
+#include "cairn/parallel/particle_transfer.hpp"
+#include "cairn/particles/particles.hpp"
+
+namespace cairn {
+
+template <int D>
+class Distribution {
+ public:
+  /// A serial run: one rank owning everything.
+  Distribution() = default;
+  /// A run over the ranks of `comm` on the grid `whole` (geometry only).
+  Distribution(const Comm& comm, const Grid<D>& whole);
+
+  [[nodiscard]] const Comm& comm() const { return comm_; }
+  /// Whether there is more than one rank (otherwise every method below is a no-op).
+  [[nodiscard]] bool active() const { return comm_.parallel(); }
+  [[nodiscard]] const Decomposition<D>& decomposition() const { return decomposition_; }
+  /// Number of partitions so far (the start-up one, then each repartition).
+  [[nodiscard]] int partitions() const { return partitions_; }
+  /// Particles this rank has received from other ranks so far (migration and partitions).
+  [[nodiscard]] std::int64_t received() const { return received_; }
+
+  /// Bisect the domain among the ranks by the cells of all particles and send each particle to
+  /// its owner (collective). `particles` holds this rank's particles (any subset: all of them
+  /// after a replicated setup, a slab of a checkpoint, the current owned set).
+  void partition(Particles<D>& particles);
+  /// Largest particle count of a rank over the mean count (1 for a serial run; collective).
+  [[nodiscard]] double imbalance(std::size_t n_owned) const;
+  /// Send the particles that left this rank's box to their owners and take in those that
+  /// entered it; the owned particles stay in increasing id (collective).
+  void migrate(Particles<D>& particles);
+
+  /// Ghost band B and window margin W for stencils of reach r (see above).
+  [[nodiscard]] static int ghost_band(int reach) { return 2 * reach + 3; }
+  [[nodiscard]] static int window_margin(int reach) { return ghost_band(reach) + reach + 2; }
+  /// The part of `whole` this rank stores for stencils of reach r, owning its box.
+  [[nodiscard]] Grid<D> window(const Grid<D>& whole, int reach) const;
+
+  /// Append to `particles` (its first n_owned() entries owned) copies of the other ranks'
+  /// particles in the ghost band, sorted by id, and record who sends which for refresh()
+  /// (collective).
+  void add_ghosts(Particles<D>& particles, int reach);
+  /// Remove the ghosts again (the end of a step).
+  void drop_ghosts(Particles<D>& particles);
+  [[nodiscard]] std::size_t n_owned() const { return n_owned_; }
+  /// Every local particle (owned and ghost) in increasing id: the serial order.
+  [[nodiscard]] const std::vector<std::int32_t>& id_order() const { return id_order_; }
+  /// Owners send their current `values` (width entries per particle) to the ghosts' copies.
+  template <class T>
+  void refresh(std::vector<T>& values, int width = 1) const {
+    if (!active() || width == 0) return;
+    Comm::Buffers send(neighbours_.size());
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) pack_values(values, width, send_list_[k], send[k]);
+    const Comm::Buffers recv = comm_.exchange(neighbours_, send);
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      std::size_t offset = 0;
+      const std::size_t row = static_cast<std::size_t>(width);
+      if (recv[k].size() != ghost_slot_[k].size() * row * sizeof(T))
+        throw std::runtime_error("ghost refresh: unexpected message size");
+      for (std::int32_t slot : ghost_slot_[k]) {
+        std::memcpy(values.data() + static_cast<std::size_t>(slot) * row, recv[k].data() + offset, row * sizeof(T));
+        offset += row * sizeof(T);
+      }
+    }
+  }
+
+ private:
+  [[nodiscard]] IVec<D> cell_of(const Vec<D>& x) const;
+
+  Comm comm_ = Comm::serial();
+  Grid<D> whole_;
+  Decomposition<D> decomposition_;
+  int partitions_ = 0;
+  std::int64_t received_ = 0;
+  std::size_t n_owned_ = 0;
+  int band_ = -1;                                  ///< ghost band of the neighbour list
+  std::vector<int> neighbours_;                    ///< ranks exchanging ghosts with this one
+  std::vector<std::vector<std::int32_t>> send_list_;   ///< per neighbour: owned particles sent
+  std::vector<std::vector<std::int32_t>> ghost_slot_;  ///< per neighbour: where its ghosts are
+  std::vector<std::int32_t> id_order_;
+};
+
+}  // namespace cairn

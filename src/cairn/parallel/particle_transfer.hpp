@@ -1,0 +1,93 @@
+// Moving particles between ranks and within a rank's arrays, through Particles::for_each_array
+// so that every per-particle array travels (docs/parallel.md, "Particle migration").
+//
+// Buffers are array-major: the selected particles' positions, then their reference positions,
+// ..., then their state variables; the receiver knows the count from the buffer size and the
+// bytes per particle (sender and receiver store the same arrays: the same run).
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "cairn/particles/particles.hpp"
+
+namespace cairn {
+
+/// Bytes one particle takes in a transfer buffer.
+template <int D>
+std::size_t particle_bytes(const Particles<D>& particles) {
+  std::size_t bytes = 0;
+  particles.for_each_array([&](const auto& array, int width) {
+    bytes += static_cast<std::size_t>(width) * sizeof(typename std::decay_t<decltype(array)>::value_type);
+  });
+  return bytes;
+}
+
+/// Append `width` entries per listed index of `values` to `out`.
+template <class T, class Index>
+void pack_values(const std::vector<T>& values, int width, const std::vector<Index>& indices, std::vector<char>& out) {
+  if (width == 0) return;
+  const std::size_t row = static_cast<std::size_t>(width) * sizeof(T);
+  std::size_t at = out.size();
+  out.resize(at + row * indices.size());
+  for (Index p : indices) {
+    std::memcpy(out.data() + at, values.data() + static_cast<std::size_t>(p) * width, row);
+    at += row;
+  }
+}
+
+/// Copy `count` particles' entries from `in` (at byte `offset`, advanced) into values[first ...].
+template <class T>
+void unpack_values(std::vector<T>& values, int width, std::size_t first, std::size_t count, const std::vector<char>& in,
+                   std::size_t& offset) {
+  if (width == 0 || count == 0) return;
+  const std::size_t bytes = count * static_cast<std::size_t>(width) * sizeof(T);
+  if (offset + bytes > in.size()) throw std::runtime_error("particle transfer: short buffer");
+  std::memcpy(values.data() + first * static_cast<std::size_t>(width), in.data() + offset, bytes);
+  offset += bytes;
+}
+
+/// Append the listed particles of `particles` to `out`, every array.
+template <int D, class Index>
+void pack_particles(const Particles<D>& particles, const std::vector<Index>& indices, std::vector<char>& out) {
+  particles.for_each_array([&](const auto& array, int width) { pack_values(array, width, indices, out); });
+}
+
+/// Append the particles in `in` (packed by pack_particles) to `particles`; returns their count.
+template <int D>
+std::size_t unpack_particles(Particles<D>& particles, const std::vector<char>& in) {
+  const std::size_t bytes = particle_bytes(particles);
+  if (bytes == 0 || in.size() % bytes != 0) throw std::runtime_error("particle transfer: buffer size mismatch");
+  const std::size_t count = in.size() / bytes, first = particles.n();
+  std::size_t offset = 0;
+  particles.for_each_array([&](auto& array, int width) {
+    array.resize((first + count) * static_cast<std::size_t>(width));
+    unpack_values(array, width, first, count, in, offset);
+  });
+  return count;
+}
+
+/// Reorder the particles: particle k becomes the old particle order[k] (order may also drop
+/// particles by listing fewer).
+template <int D>
+void reorder_particles(Particles<D>& particles, const std::vector<std::int32_t>& order) {
+  particles.for_each_array([&](auto& array, int width) {
+    if (width == 0) return;
+    using T = typename std::decay_t<decltype(array)>::value_type;
+    std::vector<T> out(order.size() * static_cast<std::size_t>(width));
+    for (std::size_t k = 0; k < order.size(); ++k)
+      for (int w = 0; w < width; ++w)
+        out[k * width + w] = array[static_cast<std::size_t>(order[k]) * width + w];
+    array.swap(out);
+  });
+}
+
+/// Keep the first n particles.
+template <int D>
+void truncate_particles(Particles<D>& particles, std::size_t n) {
+  particles.for_each_array([&](auto& array, int width) { array.resize(n * static_cast<std::size_t>(width)); });
+}
+
+}  // namespace cairn

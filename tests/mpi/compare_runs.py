@@ -1,0 +1,156 @@
+#!/usr/bin/python3
+"""Run one case serially and on several MPI ranks and require the same results, bit for bit.
+
+Checks (docs/parallel.md, "Determinism"):
+  - history.csv: every column of the serial file is in the MPI file with the same text in every
+    row (17 significant digits, so the same doubles); the MPI file adds `imbalance`;
+  - the last snapshot: every particle dataset equal to the serial one after sorting by id;
+  - --migrate / --repartition: the MPI run moved particles between ranks / partitioned the
+    domain again (its summary line says how often);
+  - --restart N:M: the checkpoint the N-rank run wrote first, continued on M ranks, ends with
+    the serial run's history and final particles.
+Exit 0 only when every check holds; the last line says RESULT: ...
+"""
+import argparse
+import csv
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+
+def run(cmd, cwd=None):
+    env = dict(os.environ, OMP_NUM_THREADS="1", OMP_WAIT_POLICY="PASSIVE")
+    done = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
+    if done.returncode != 0:
+        print(" ".join(map(str, cmd)))
+        print(done.stdout[-3000:])
+        print(done.stderr[-3000:])
+        raise SystemExit(f"RESULT: FAIL ({Path(cmd[-1]).name if cmd else '?'}: exit {done.returncode})")
+    return done.stdout + done.stderr
+
+
+def mpirun(args, n):
+    return [args.mpirun, "--oversubscribe", "--allow-run-as-root", "-np", str(n)]
+
+
+def read_history(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def compare_history(serial_dir, mpi_dir, label):
+    problems = []
+    head_s, rows_s = read_history(serial_dir / "history.csv")
+    head_m, rows_m = read_history(mpi_dir / "history.csv")
+    if len(rows_s) != len(rows_m):
+        return [f"{label}: {len(rows_m)} history rows, serial {len(rows_s)}"]
+    for c, name in enumerate(head_s):
+        if name not in head_m:
+            problems.append(f"{label}: history column {name} missing")
+            continue
+        cm = head_m.index(name)
+        for r, (a, b) in enumerate(zip(rows_s, rows_m)):
+            if a[c] != b[cm]:
+                x, y = float(a[c]), float(b[cm])
+                rel = abs(x - y) / max(abs(x), abs(y), 1e-300)
+                problems.append(f"{label}: history {name} row {r}: serial {a[c]}, MPI {b[cm]} (relative {rel:.2e})")
+                break
+    return problems
+
+
+def last_snapshot(directory):
+    files = sorted((directory / "snapshots").glob("particles-*.h5"))
+    if not files:
+        raise SystemExit(f"RESULT: FAIL (no snapshot in {directory})")
+    return files[-1]
+
+
+def by_id(path):
+    with h5py.File(path, "r") as f:
+        g = f["particles"]
+        ids = g["id"][()]
+        order = np.argsort(ids, kind="stable")
+        data = {name: g[name][()][order] for name in g}
+        time = f.attrs["time"]
+    return time, data
+
+
+def compare_snapshots(serial_dir, mpi_dir, label):
+    t_s, a = by_id(last_snapshot(serial_dir))
+    t_m, b = by_id(last_snapshot(mpi_dir))
+    problems = []
+    if t_s != t_m:
+        problems.append(f"{label}: last snapshot at t = {t_m}, serial {t_s}")
+    for name, values in a.items():
+        if name == "connectivity":  # the file's row numbers (XDMF cells), not a particle property
+            continue
+        if name not in b:
+            problems.append(f"{label}: snapshot dataset {name} missing")
+        elif values.shape != b[name].shape:
+            problems.append(f"{label}: snapshot {name} shape {b[name].shape}, serial {values.shape}")
+        elif not np.array_equal(values, b[name], equal_nan=values.dtype.kind == "f"):
+            diff = np.nanmax(np.abs(values - b[name])) if values.dtype.kind == "f" else "ints"
+            problems.append(f"{label}: snapshot {name} differs (largest difference {diff})")
+    return problems
+
+
+def counts(summary):
+    m = re.search(r"(\d+) domain partitions, (\d+) particles moved between ranks", summary)
+    if not m:
+        raise SystemExit("RESULT: FAIL (no MPI summary line)\n" + summary[-2000:])
+    return int(m.group(1)), int(m.group(2))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--cairn", required=True)
+    ap.add_argument("--mpirun", default="mpirun")
+    ap.add_argument("--case", required=True, type=Path)
+    ap.add_argument("--out", required=True, type=Path)
+    ap.add_argument("--np", type=int, nargs="+", default=[2])
+    ap.add_argument("--migrate", action="store_true", help="require particles to move between ranks")
+    ap.add_argument("--repartition", action="store_true", help="require a repartition during the run")
+    ap.add_argument("--restart", default="", help="N:M - continue the N-rank run's first checkpoint on M ranks")
+    args = ap.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    problems = []
+    serial = args.out / "serial"
+    run([args.cairn, "run", args.case, "--set", f"output.directory=\"{serial}\""])
+    for n in args.np:
+        d = args.out / f"np{n}"
+        summary = run(mpirun(args, n) + [args.cairn, "run", args.case, "--set", f"output.directory=\"{d}\""])
+        if f"with {n} MPI ranks x 1 thread" not in summary:
+            problems.append(f"np {n}: the summary does not say '{n} MPI ranks x 1 thread'")
+        partitions, moved = counts(summary)
+        print(f"np {n}: {partitions} partitions, {moved} particles moved between ranks")
+        if args.migrate and moved == 0:
+            problems.append(f"np {n}: no particle moved between ranks")
+        if args.repartition and partitions < 2:
+            problems.append(f"np {n}: the domain was never repartitioned")
+        problems += compare_history(serial, d, f"np {n}")
+        problems += compare_snapshots(serial, d, f"np {n}")
+    if args.restart:
+        first, then = (int(v) for v in args.restart.split(":"))
+        checkpoint = args.out / f"np{first}" / "checkpoint-0000.h5"
+        d = args.out / f"restart{first}to{then}"
+        run(mpirun(args, then) + [args.cairn, "restart", checkpoint, "--set", f"output.directory=\"{d}\""])
+        problems += compare_history(serial, d, f"restart {first}->{then}")
+        problems += compare_snapshots(serial, d, f"restart {first}->{then}")
+    for p in problems:
+        print(p)
+    ranks = ", ".join(map(str, args.np)) + (f"; restart {args.restart}" if args.restart else "")
+    if problems:
+        print(f"RESULT: FAIL {args.case.stem} ({len(problems)} differences from the serial run; ranks {ranks})")
+        return 1
+    print(f"RESULT: PASS {args.case.stem}: history and particles bit-identical to the serial run on {ranks} ranks")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,176 @@
+// The serial-testable pieces of the MPI distribution (docs/parallel.md): exact sums that do not
+// depend on the order of their terms, the recursive bisection, grid windows, and the generic
+// particle-array transfers. The runs on 2-4 ranks are ctest cases under mpirun (tests/mpi).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/parallel/decomposition.hpp"
+#include "cairn/parallel/exact_sum.hpp"
+#include "cairn/parallel/particle_transfer.hpp"
+
+namespace cairn {
+namespace {
+
+TEST(ExactSum, OrderDoesNotChangeTheSum) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-60, 60);
+  std::vector<double> terms(5000);
+  for (double& t : terms) t = std::ldexp(mantissa(rng), exponent(rng));
+  ExactSum forward;
+  for (double t : terms) forward.add(t);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::shuffle(terms.begin(), terms.end(), rng);
+    // Split into uneven parts summed separately and merged: a partition over ranks/threads.
+    ExactSum parts[3];
+    for (std::size_t k = 0; k < terms.size(); ++k) parts[(k * k) % 3].add(terms[k]);
+    ExactSum merged = parts[2];
+    merged += parts[0];
+    merged += parts[1];
+    EXPECT_EQ(merged.value(), forward.value());
+  }
+  // A naive sum in two orders differs here (cancellation over 120 binary orders of magnitude),
+  // so the test can fail for an order-dependent sum.
+  double a = 0.0, b = 0.0;
+  for (double t : terms) a += t;
+  std::reverse(terms.begin(), terms.end());
+  for (double t : terms) b += t;
+  EXPECT_NE(a, b);
+}
+
+TEST(ExactSum, IsExactWhereDoublesCancel) {
+  ExactSum s;
+  s.add(1e300);
+  s.add(1.0);
+  s.add(-1e300);
+  s.add(1e-300);
+  EXPECT_EQ(s.value(), 1.0);  // a naive sum gives 0
+  ExactSum tiny;
+  tiny.add(std::numeric_limits<double>::denorm_min());
+  tiny.add(std::numeric_limits<double>::denorm_min());
+  EXPECT_EQ(tiny.value(), 2 * std::numeric_limits<double>::denorm_min());
+  ExactSum neg;
+  neg.add(-3.5);
+  neg.add(1.25);
+  EXPECT_EQ(neg.value(), -2.25);
+  ExactSum special;
+  special.add(1.0);
+  special.add(std::numeric_limits<double>::infinity());
+  EXPECT_EQ(special.value(), std::numeric_limits<double>::infinity());
+  special.add(-std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(std::isnan(special.value()));
+}
+
+TEST(ExactSum, RoundsWithinAnUlp) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  long double reference = 0.0L;
+  ExactSum s;
+  for (int k = 0; k < 100000; ++k) {
+    const double t = u(rng);
+    s.add(t);
+    reference += t;
+  }
+  EXPECT_NEAR(s.value(), static_cast<double>(reference), 2e-16 * static_cast<double>(reference));
+}
+
+TEST(Decomposition, BisectsByParticlesAndCoversEveryCell) {
+  // One rank: the serial Comm gives one box. The splitting itself is exercised on several
+  // ranks by the mpirun cases; here the owner lookup and the neighbour test.
+  IVec<2> n(40, 10);
+  Decomposition<2> d(n, {false, true});
+  EXPECT_EQ(d.n_boxes(), 1);
+  EXPECT_EQ(d.owner(IVec<2>(-5, 3)), 0);
+  EXPECT_EQ(d.domain_cell(IVec<2>(-5, 12)), IVec<2>(0, 2));
+  EXPECT_EQ(d.domain_cell(IVec<2>(45, -1)), IVec<2>(39, 9));
+  std::vector<IVec<2>> cells{IVec<2>(1, 1), IVec<2>(2, 2)};
+  const Decomposition<2> b = Decomposition<2>::bisect(Comm::serial(), n, {false, true}, cells);
+  EXPECT_EQ(b.n_boxes(), 1);
+  EXPECT_EQ(b.box(0).hi, n);
+  EXPECT_TRUE(b.near(0, IVec<2>(41, 3), 2));
+  EXPECT_FALSE(b.near(0, IVec<2>(42, 3), 2));
+}
+
+TEST(GridWindow, TranslatesBetweenDomainAndStorage) {
+  // 20 x 8 cells, x not periodic with 2 ghost layers, y periodic.
+  Grid<2> whole(Vec<2>(0.0, 0.0), IVec<2>(20, 8), Vec<2>(0.5, 0.5), 2, {false, true});
+  const Grid<2> w = whole.window(IVec<2>(5, -2), IVec<2>(6, 5), IVec<2>(7, 0), IVec<2>(9, 1));
+  EXPECT_EQ(w.n_nodes(), 30);
+  EXPECT_EQ(w.first_node(0), 5);
+  EXPECT_FALSE(w.is_whole());
+  EXPECT_TRUE(whole.is_whole());
+  for (std::int32_t i = 0; i < w.n_nodes(); ++i) {
+    const IVec<2> j = w.multi_index(i);
+    EXPECT_EQ(w.node_index(j), i);
+    EXPECT_GE(j[1], 0);  // periodic axes report the domain numbering
+    EXPECT_LT(j[1], 8);
+    EXPECT_EQ(w.node_position(i), whole.node_position(whole.node_index(j)));
+  }
+  EXPECT_EQ(w.node_index(IVec<2>(4, 0)), -1);  // left of the window
+  EXPECT_GE(w.node_index(IVec<2>(5, 6)), 0);   // y = -2 wraps to 6
+  EXPECT_EQ(w.node_index(IVec<2>(5, 3)), -1);  // y = 3 beyond the window's 5 rows
+  // Ownership: cells [7, 9) x [0, 1); the upper face and the ghosts count for the last cell.
+  EXPECT_TRUE(w.owns(w.node_index(IVec<2>(8, 0))));
+  EXPECT_FALSE(w.owns(w.node_index(IVec<2>(9, 0))));
+  EXPECT_FALSE(w.owns(w.node_index(IVec<2>(8, 1))));
+  // Clipping to the stored ghost layers on the non-periodic axis, the whole ring on y.
+  const Grid<2> edge = whole.window(IVec<2>(-10, -10), IVec<2>(15, 40), IVec<2>(0, 0), IVec<2>(3, 8));
+  EXPECT_EQ(edge.first_node(0), -2);
+  EXPECT_EQ(edge.stored_nodes(0), 7);
+  EXPECT_EQ(edge.stored_nodes(1), 8);
+  EXPECT_TRUE(edge.owns(edge.node_index(IVec<2>(-2, 5))));
+}
+
+TEST(ParticleTransfer, EveryArrayTravels) {
+  Particles<2> a;
+  a.n_state_per_particle = 2;
+  a.has_affine = true;
+  a.has_temperature = true;
+  for (int p = 0; p < 6; ++p) {
+    a.add(Vec<2>(p, 2.0 * p), Vec<2>(-p, 1.0), 1.0 + p, 0.5, Vec<2>(0.1, 0.2), p % 2, p % 3);
+    a.state[2 * p] = 10.0 * p;
+    a.state[2 * p + 1] = -p;
+    a.temperature[p] = 300.0 + p;
+    a.affine_velocity[p](0, 1) = p;
+    a.deformation_gradient[p](1, 0) = 0.01 * p;
+  }
+  std::vector<char> buffer;
+  pack_particles(a, std::vector<std::int32_t>{4, 1}, buffer);
+  EXPECT_EQ(buffer.size(), 2 * particle_bytes(a));
+  Particles<2> b;
+  b.n_state_per_particle = 2;
+  EXPECT_EQ(unpack_particles(b, buffer), 2u);
+  ASSERT_EQ(b.n(), 2u);
+  EXPECT_EQ(b.id[0], 4);
+  EXPECT_EQ(b.id[1], 1);
+  EXPECT_EQ(b.state[2], 10.0);
+  EXPECT_EQ(b.temperature[0], 304.0);
+  EXPECT_EQ(b.affine_velocity[1](0, 1), 1.0);
+  EXPECT_DOUBLE_EQ(b.deformation_gradient[0](1, 0), 0.04);
+  EXPECT_EQ(b.position[1], Vec<2>(1.0, 2.0));
+  EXPECT_EQ(b.body[0], 1);
+  reorder_particles(b, {1, 0});
+  EXPECT_EQ(b.id[0], 1);
+  EXPECT_EQ(b.state[1], -1.0);
+}
+
+TEST(ParticleTransfer, TheArrayListCoversTheStruct) {
+  // Particles holds n_arrays vectors and three scalars (n_state_per_particle, has_affine,
+  // has_temperature). An array added to the struct without for_each_array changes the size.
+  Particles<3> p;
+  int visited = 0;
+  p.for_each_array([&](auto&, int) { ++visited; });
+  EXPECT_EQ(visited, Particles<3>::n_arrays);
+  struct Scalars {
+    int n;
+    bool a, t;
+  };
+  EXPECT_EQ(sizeof(Particles<3>), Particles<3>::n_arrays * sizeof(std::vector<double>) + sizeof(Scalars));
+}
+
+}  // namespace
+}  // namespace cairn
