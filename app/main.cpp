@@ -64,6 +64,9 @@ void print_summary(const cairn::RunSummary& s) {
              "{} {}s)\n",
              s.steps, s.end_time, s.wall_seconds, s.particle_steps_per_second, s.item, workers,
              s.n_particles, s.item);
+  if (s.adaptive_threads)
+    fmt::print("cairn: adaptive threads: {} of {} steps on 1 thread (simulation.adapt_threads)\n",
+               s.single_thread_steps, s.steps);
   if (s.ranks > 1)
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);
@@ -104,13 +107,16 @@ constexpr int max_threads = 1024;
 }  // namespace
 
 int main(int argc, char** argv) {
-  // OpenMP threads that wait at a barrier sleep instead of spinning, unless the user chose a
-  // policy: spinning makes 2 threads many times slower than 1 when another process is busy on
-  // the machine (docs/performance.md, "Threads on a shared machine"). libgomp reads the policy
-  // when it loads, before main, so the process restarts itself once with it set (same pid),
+  // OpenMP threads that wait at a barrier spin briefly (1000 rounds, about 35 us here) and then
+  // sleep, unless the user chose a policy: spinning without bound makes 2 threads many times
+  // slower than 1 when another process is busy on the machine, sleeping at once makes every
+  // hand-off between the step's parallel regions cost a wake-up (docs/performance.md, "Threads
+  // on a shared machine"; the run loop also falls back to one thread when that is faster,
+  // sim/thread_tuner.hpp). libgomp reads the setting when it loads, before main, so the process
+  // restarts itself once with it set (same pid),
   // before MPI is initialised.
   if (std::getenv("OMP_WAIT_POLICY") == nullptr && std::getenv("GOMP_SPINCOUNT") == nullptr) {
-    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    ::setenv("GOMP_SPINCOUNT", "1000", 1);
     ::execv("/proc/self/exe", argv);  // returns only on failure: go on with the runtime's default
   }
   // Under mpirun/srun every rank runs this program (docs/parallel.md); rank 0 alone prints.

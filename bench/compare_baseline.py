@@ -55,9 +55,9 @@ def build_current():
     return os.path.join(ROOT, "build", "release", "cairn")
 
 
-def run_once(binary, problem, threads, scratch, scale):
+def run_once(binary, problem, threads, scratch, scale, more=()):
     toml, extra = PROBLEMS[problem]
-    extra = list(extra)
+    extra = list(extra) + list(more)
     if scale != 1.0:
         extra = [re.sub(r"max_steps=(\d+)", lambda m: f"max_steps={max(1, round(int(m.group(1)) * scale))}", e)
                  for e in extra]

@@ -1,15 +1,19 @@
 #!/usr/bin/python3
 """2 threads against 1 thread, on an idle machine and beside a CPU-bound neighbour.
 
-For each problem of bench/problems/ (compare_baseline.py's a-d) and each OpenMP wait policy
-setting, runs `cairn run -t 1` and `-t 2` in alternating pairs and prints the median
-particle-steps/s and the median per-pair speed-up, first alone, then while one busy-looping
-process (a second /usr/bin/python3 spinning) competes for the 2 cores.
+For each problem of bench/problems/ (compare_baseline.py's a-d), runs `cairn run -t 1` and, for
+each setting, `-t 2` in rounds (the order rotates from round to round) and prints the median
+particle-steps/s and the median per-round speed-up over the round's 1-thread run, first alone,
+then while one busy-looping process (/usr/bin/python3 spinning) competes for the cores.
 
   /usr/bin/python3 bench/thread_scaling.py [--cairn build/release/cairn] [--problems a d]
-      [--pairs 3] [--policies default PASSIVE ACTIVE]
+      [--pairs 3] [--settings default PASSIVE spin=1000 fixed:spin=1000] [--steps-scale 1]
 
-"default" leaves OMP_WAIT_POLICY unset (what a user gets); the others set it for the run.
+A setting is the OpenMP wait policy of the 2-thread run: "default" leaves OMP_WAIT_POLICY and
+GOMP_SPINCOUNT unset (what a user gets: cairn picks its own default, app/main.cpp), PASSIVE or
+ACTIVE set OMP_WAIT_POLICY, spin=N sets GOMP_SPINCOUNT=N. The prefix "fixed:" turns the adaptive
+thread count off (simulation.adapt_threads = false), so the run keeps 2 threads throughout.
+The 1-thread reference runs with the "default" environment.
 """
 import argparse
 import os
@@ -20,20 +24,28 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import compare_baseline as cb  # noqa: E402
 
+VARS = ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")
 
-def run(binary, problem, threads, policy, scratch):
-    saved = os.environ.get("OMP_WAIT_POLICY")
-    if policy == "default":
-        os.environ.pop("OMP_WAIT_POLICY", None)
-    else:
+
+def run(binary, problem, threads, setting, scratch, scale):
+    saved = {k: os.environ.get(k) for k in VARS}
+    fixed = setting.startswith("fixed:")
+    policy = setting.split(":", 1)[1] if fixed else setting
+    for k in VARS:
+        os.environ.pop(k, None)
+    if policy.startswith("spin="):
+        os.environ["GOMP_SPINCOUNT"] = policy[5:]
+    elif policy != "default":
         os.environ["OMP_WAIT_POLICY"] = policy
+    more = ["--set", "simulation.adapt_threads=false"] if fixed else []
     try:
-        return cb.run_once(binary, problem, threads, scratch, 1.0)
+        return cb.run_once(binary, problem, threads, scratch, scale, more)
     finally:
-        if saved is None:
-            os.environ.pop("OMP_WAIT_POLICY", None)
-        else:
-            os.environ["OMP_WAIT_POLICY"] = saved
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def main():
@@ -41,36 +53,46 @@ def main():
     ap.add_argument("--cairn", default=os.path.join(cb.ROOT, "build", "release", "cairn"))
     ap.add_argument("--problems", nargs="+", default=["a", "d"], choices=sorted(cb.PROBLEMS))
     ap.add_argument("--pairs", type=int, default=3)
-    ap.add_argument("--policies", nargs="+", default=["default", "PASSIVE"])
+    ap.add_argument("--settings", nargs="+", default=["default", "fixed:default", "fixed:PASSIVE"])
+    ap.add_argument("--steps-scale", type=float, default=1.0)
+    ap.add_argument("--only", choices=["alone", "busy"], default=None)
     args = ap.parse_args()
     scratch = f"/tmp/cairn-threads-{os.getpid()}"
     rows = []
     for busy in (False, True):
+        if args.only and args.only != ("busy" if busy else "alone"):
+            continue
         neighbour = subprocess.Popen(["/usr/bin/python3", "-c", "while True: pass"]) if busy else None
+        load = os.getloadavg()[0]
         try:
             for prob in args.problems:
-                for policy in args.policies:
-                    one, two, ratios = [], [], []
-                    for r in range(args.pairs):
-                        order = [1, 2] if r % 2 == 0 else [2, 1]
-                        got = {t: run(args.cairn, prob, t, policy, scratch) for t in order}
-                        one.append(got[1])
-                        two.append(got[2])
-                        ratios.append(got[2] / got[1])
-                    rows.append((prob, "busy" if busy else "alone", policy, statistics.median(one),
-                                 statistics.median(two), statistics.median(ratios), min(ratios), max(ratios)))
-                    print(f"  ({prob}) {rows[-1][1]}, {policy}: 2 threads / 1 thread = "
-                          f"{rows[-1][5]:.2f} (pairs {', '.join(f'{x:.2f}' for x in ratios)})", flush=True)
+                configs = [(1, "default")] + [(2, s) for s in args.settings]
+                got = {c: [] for c in configs}
+                ratios = {s: [] for s in args.settings}
+                for r in range(args.pairs):
+                    k = r % len(configs)
+                    order = configs[k:] + configs[:k]
+                    res = {c: run(args.cairn, prob, c[0], c[1], scratch, args.steps_scale) for c in order}
+                    for c in configs:
+                        got[c].append(res[c])
+                    for s in args.settings:
+                        ratios[s].append(res[(2, s)] / res[(1, "default")])
+                    print(f"  ({prob}) {'busy' if busy else 'alone'} round {r + 1}: 1 thread {res[(1, 'default')]:.3g}; "
+                          + ", ".join(f"{s} {res[(2, s)] / res[(1, 'default')]:.2f}" for s in args.settings), flush=True)
+                for s in args.settings:
+                    rows.append((prob, "busy" if busy else "alone", s, statistics.median(got[(1, "default")]),
+                                 statistics.median(got[(2, s)]), statistics.median(ratios[s]), min(ratios[s]),
+                                 max(ratios[s]), load))
         finally:
             if neighbour:
                 neighbour.kill()
                 neighbour.wait()
-    print(f"\nload average {os.getloadavg()[0]:.1f} at end; particle-steps/s, medians of {args.pairs} "
-          "alternating pairs; 'busy': one CPU-bound process beside the run")
-    print("| problem | machine | OMP_WAIT_POLICY | 1 thread | 2 threads | 2 / 1 (min-max) |")
-    print("|---|---|---|---:|---:|---:|")
-    for prob, busy, policy, a, b, r, lo, hi in rows:
-        print(f"| ({prob}) | {busy} | {policy} | {a / 1e6:.2f} M | {b / 1e6:.2f} M | {r:.2f} ({lo:.2f}-{hi:.2f}) |")
+    print(f"\nload average {os.getloadavg()[0]:.1f} at end; particle-steps/s, medians of {args.pairs} rounds; "
+          "'busy': one CPU-bound process beside the run; load: 1-minute load average at the start of the block")
+    print("| problem | machine | load | 2-thread setting | 1 thread | 2 threads | 2 / 1 (min-max) |")
+    print("|---|---|---:|---|---:|---:|---:|")
+    for prob, busy, s, a, b, r, lo, hi, load in rows:
+        print(f"| ({prob}) | {busy} | {load:.1f} | {s} | {a / 1e6:.2f} M | {b / 1e6:.2f} M | {r:.2f} ({lo:.2f}-{hi:.2f}) |")
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 #include "cairn/bc/grid_conditions.hpp"
 
+#include "cairn/util/parallel.hpp"
+
 namespace cairn {
 
 template <int D>
@@ -47,7 +49,7 @@ template <int D>
 void GridConditions<D>::apply(std::vector<Vec<D>>& velocity, const std::vector<double>& mass,
                               std::vector<Vec<D>>* reaction, double dt, std::int32_t offset) const {
   const auto n_held = static_cast<std::int64_t>(nodes_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n_held >= parallel_min_items)
   for (std::int64_t k = 0; k < n_held; ++k) {
     const std::int32_t i = nodes_[k] + offset;
     for (int a = 0; a < D; ++a) {
@@ -60,7 +62,7 @@ void GridConditions<D>::apply(std::vector<Vec<D>>& velocity, const std::vector<d
   // Held components first; then all mirror images are read before any is written, so the result
   // does not depend on the order of the lists.
   const auto n_mirrors = static_cast<std::int64_t>(mirrors_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n_mirrors >= parallel_min_items)
   for (std::int64_t k = 0; k < n_mirrors; ++k) {
     const Mirror& m = mirrors_[k];
     Vec<D> v = velocity[m.source + offset];
@@ -68,7 +70,7 @@ void GridConditions<D>::apply(std::vector<Vec<D>>& velocity, const std::vector<d
       if (m.negate & (1u << a)) v[a] = -v[a];
     mirrored_[k] = v;
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n_mirrors >= parallel_min_items)
   for (std::int64_t k = 0; k < n_mirrors; ++k) {
     const std::int32_t i = mirrors_[k].node + offset;
     if (reaction) (*reaction)[i] += mass[i] * (mirrored_[k] - velocity[i]) / dt;

@@ -899,6 +899,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.max_steps = r.integer("max_steps");
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
+  s.adapt_threads = r.boolean("adapt_threads");
   s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
   s.rebalance_threshold = r.real("rebalance_threshold");
@@ -1711,6 +1712,7 @@ std::string config_to_toml(const Config& c) {
   line("max_steps", fmt::format("{}", s.max_steps));
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
+  line("adapt_threads", s.adapt_threads ? "true" : "false");
   line("rebalance_threshold", real_text(s.rebalance_threshold));
   line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));

@@ -106,6 +106,11 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("0")
                 .min(0)
                 .max(1024));
+  k.push_back(Key("simulation", "adapt_threads", T::boolean,
+                 "Between steps, time the step with all threads and, now and then, with one, and "
+                 "run with the faster (a busy machine makes a team of threads slower than one "
+                 "thread); results do not depend on the thread count. false: always all threads.")
+                .by_default("true"));
   k.push_back(Key("simulation", "rebalance_threshold", T::real,
                  "Runs on several MPI ranks (docs/parallel.md): repartition the domain when the "
                  "largest particle count of a rank exceeds the mean count by more than this "

@@ -25,6 +25,7 @@
 #include "cairn/io/snapshot.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/sim/thread_tuner.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/integrator.hpp"
 
@@ -217,13 +218,17 @@ class Runner {
       write_history_row();
       write_snapshot();
     }
+    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads);
     while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
+      tuner.before_step();
+      const auto step_start = Clock::now();
       const double dt = sim_.next_dt();
       try {
         sim_.step(dt);
       } catch (const SimulationFailure& f) {
         fail(f, dt);
       }
+      tuner.after_step(std::chrono::duration<double>(Clock::now() - step_start).count());
       last_dt_ = dt;
       max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
       measure_error();
@@ -245,6 +250,7 @@ class Runner {
       if (decide[1] != 0) interrupted(static_cast<int>(decide[1]));
       progress(start, first_step);
     }
+    tuner.finish();
     schedule_.at_end([&] { write_history_row(); }, [&] { write_snapshot(); });
     flush_history();
     if (config_.output.checkpoints) write_checkpoint_file();
@@ -265,6 +271,8 @@ class Runner {
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
     summary.stage_seconds = sim_.stage_times();
+    summary.adaptive_threads = tuner.enabled();
+    summary.single_thread_steps = tuner.single_thread_steps();
     if (const auto* c = sim_.contact()) {
       summary.contact_prepare_seconds = c->prepare_seconds();
       summary.contact_fit_seconds = c->fit_seconds();

@@ -30,6 +30,10 @@ struct RunSummary {
   std::filesystem::path last_checkpoint;
   /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).
   std::vector<std::pair<std::string, double>> stage_seconds;
+  /// Whether the thread count adapted to measured step times (sim/thread_tuner.hpp), and the
+  /// steps it ran on one thread.
+  bool adaptive_threads = false;
+  long long single_thread_steps = 0;
   /// Multimaterial runs: seconds in contact preparation (of which normal/separation fits) and
   /// corrections (inside the stages above), and contact nodes summed over the steps.
   double contact_prepare_seconds = 0.0, contact_fit_seconds = 0.0, contact_correct_seconds = 0.0;

@@ -332,7 +332,7 @@ double Simulation<D>::max_signal_speed() const {
     if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
   }
   double v2_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v2_max)
+#pragma omp parallel for reduction(max : c_max, v2_max) if (n >= parallel_min_items)
   for (std::int64_t p = 0; p < n; ++p) {
     const std::int32_t m = particles_.material[p];
     if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));

@@ -36,7 +36,7 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     return static_cast<int>(std::clamp<long long>(b, 0, n_blocks[a] - 1));
   };
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= parallel_min_items)
   for (std::int64_t p = 0; p < n; ++p) {
     const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
     int id = 0, mult = 1;

@@ -21,6 +21,7 @@
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
+#include "cairn/util/parallel.hpp"
 
 namespace cairn {
 
@@ -240,9 +241,11 @@ std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std:
 template <int D, class Fn>
 void scatter(const TransferCache<D>& cache, Fn&& fn) {
   with_stencils(cache, [&](auto stencil_of) {
+    // One team for all colours; the barrier at the end of each colour's loop keeps them apart.
+#pragma omp parallel
     for (const auto& blocks : cache.colour_blocks) {
       const auto n_blocks = static_cast<std::int64_t>(blocks.size());
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp for schedule(dynamic, 1)
       for (std::int64_t b = 0; b < n_blocks; ++b) {
         const std::int32_t block = blocks[b];
         for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
@@ -298,10 +301,10 @@ ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
   return total;
 }
 
-/// Parallel loop over nodes.
+/// Parallel loop over nodes (on the calling thread for small grids, util/parallel.hpp).
 template <class Fn>
 void for_each_node(std::int32_t n_nodes, Fn&& fn) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n_nodes >= parallel_min_items)
   for (std::int32_t i = 0; i < n_nodes; ++i) fn(i);
 }
 

@@ -1,0 +1,95 @@
+// Adaptive thread count: run with all threads or with one, whichever the measured step times say
+// is faster right now (docs/performance.md, "Threads on a shared machine").
+//
+// On a machine shared with other busy processes a team of threads loses time at every barrier
+// waiting for a member that lost its core; on an idle machine it runs nearly twice as fast on
+// two cores. Neither can be known before the run, and the load changes during it, so the run
+// loop times its steps: it holds the current choice for a while, then runs a short probe with
+// the other count and keeps whichever was faster per step. The hold grows while the choice
+// stays the same (the probes cost less and less of the run) and shrinks again when it changes.
+// Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
+// changes nothing but the speed.
+#pragma once
+
+#include <omp.h>
+
+#include <algorithm>
+
+namespace cairn {
+
+class ThreadTuner {
+ public:
+  /// Steps of a probe not timed (the first step after a switch wakes or parks threads), steps
+  /// timed at the end of a hold and of a probe, and the hold lengths.
+  static constexpr int warm_steps = 1, timed_steps = 2;
+  static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
+  /// A step of the full team that takes longer than this is not probed with one thread: its
+  /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
+  static constexpr double long_step = 0.02;
+
+  /// max_threads: the team size the run was given; tuning is off for 1 thread or !enabled.
+  ThreadTuner(int max_threads, bool enabled) : max_(max_threads), enabled_(enabled && max_threads > 1) {
+    chosen_ = current_ = max_;
+    hold_ = warm_steps + timed_steps;  // the first hold only measures the full team
+  }
+
+  [[nodiscard]] bool enabled() const { return enabled_; }
+  [[nodiscard]] int threads() const { return current_; }
+  /// Steps taken with one thread while tuning (0 when tuning is off).
+  [[nodiscard]] long long single_thread_steps() const { return single_steps_; }
+  [[nodiscard]] long long steps() const { return steps_; }
+
+  /// Sets OpenMP's thread count for the next step.
+  void before_step() const {
+    if (enabled_) omp_set_num_threads(current_);
+  }
+
+  /// Records the wall seconds of the step just taken and picks the count for the next one.
+  void after_step(double seconds) {
+    if (!enabled_) return;
+    ++steps_;
+    if (current_ == 1) ++single_steps_;
+    ++in_phase_;
+    const long long length = probing_ ? warm_steps + timed_steps : hold_;
+    if (in_phase_ > length - timed_steps) timed_ += seconds;
+    if (in_phase_ < length) return;
+    const double per_step = timed_ / timed_steps;
+    in_phase_ = 0;
+    timed_ = 0.0;
+    if (!probing_) {
+      // End of a hold: time per step of the choice, then a probe of the other count.
+      chosen_time_ = per_step;
+      if (chosen_ == max_ && per_step > long_step) {
+        hold_ = longest_hold;
+        return;
+      }
+      current_ = chosen_ == 1 ? max_ : 1;
+      probing_ = true;
+      return;
+    }
+    probing_ = false;
+    if (per_step < chosen_time_) {
+      chosen_ = current_;
+      hold_ = first_hold;
+    } else {
+      hold_ = std::min(longest_hold, std::max(first_hold, hold_ * hold_growth));
+    }
+    current_ = chosen_;
+  }
+
+  /// Gives OpenMP back the full team (for what runs after the loop).
+  void finish() const {
+    if (enabled_) omp_set_num_threads(max_);
+  }
+
+ private:
+  int max_ = 1;
+  bool enabled_ = false;
+  int chosen_ = 1, current_ = 1;
+  bool probing_ = false;
+  long long hold_ = 1, in_phase_ = 0;
+  double timed_ = 0.0, chosen_time_ = 0.0;
+  long long steps_ = 0, single_steps_ = 0;
+};
+
+}  // namespace cairn

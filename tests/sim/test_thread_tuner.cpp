@@ -1,0 +1,90 @@
+// The adaptive thread count (sim/thread_tuner.hpp): fed synthetic step times, it settles on the
+// faster count and probes the other less and less often; switching the count between steps
+// leaves the results bit-identical. No test here times anything.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include "../support/config_builder.hpp"
+#include "cairn/sim/simulation.hpp"
+#include "cairn/sim/thread_tuner.hpp"
+
+namespace cairn {
+namespace {
+
+/// Steps the tuner `steps` times, each step taking full_time with the full team and single_time
+/// with one thread; returns the steps taken with one thread.
+long long drive(ThreadTuner& tuner, int steps, double full_time, double single_time) {
+  for (int s = 0; s < steps; ++s) tuner.after_step(tuner.threads() == 1 ? single_time : full_time);
+  return tuner.single_thread_steps();
+}
+
+TEST(ThreadTuner, SettlesOnOneThreadWhenTheTeamIsSlower) {
+  const int saved = omp_get_max_threads();
+  ThreadTuner tuner(2, true);
+  const long long single = drive(tuner, 1000, 2e-3, 1e-3);
+  EXPECT_EQ(tuner.threads(), 1);
+  // Only the first hold and the probes of the full team run on 2 threads.
+  EXPECT_GT(single, 950);
+  tuner.before_step();
+  EXPECT_EQ(omp_get_max_threads(), 1);
+  tuner.finish();
+  EXPECT_EQ(omp_get_max_threads(), 2);
+  omp_set_num_threads(saved);
+}
+
+TEST(ThreadTuner, KeepsTheTeamWhenItIsFasterAndProbesLessOften) {
+  ThreadTuner tuner(2, true);
+  const long long single = drive(tuner, 4000, 0.5e-3, 1e-3);
+  EXPECT_EQ(tuner.threads(), 2);
+  // Probes of 3 steps after holds of 3, 16, 64, 256, 1024, 1024 and 1024 steps.
+  EXPECT_EQ(single, 7 * (ThreadTuner::warm_steps + ThreadTuner::timed_steps));
+  EXPECT_GT(single, 0);
+}
+
+TEST(ThreadTuner, FollowsAChangeOfLoad) {
+  ThreadTuner tuner(2, true);
+  drive(tuner, 2000, 0.5e-3, 1e-3);  // idle machine: the team wins
+  ASSERT_EQ(tuner.threads(), 2);
+  drive(tuner, 1100, 3e-3, 1e-3);  // a neighbour got busy: one probe later, one thread
+  EXPECT_EQ(tuner.threads(), 1);
+}
+
+TEST(ThreadTuner, LongStepsKeepTheTeamWithoutProbes) {
+  ThreadTuner tuner(2, true);
+  EXPECT_EQ(drive(tuner, 3000, 2.0 * ThreadTuner::long_step, 1.5 * ThreadTuner::long_step), 0);
+  EXPECT_EQ(tuner.threads(), 2);
+}
+
+TEST(ThreadTuner, OffForOneThreadOrWhenDisabled) {
+  ThreadTuner one(1, true), off(4, false);
+  EXPECT_FALSE(one.enabled());
+  EXPECT_FALSE(off.enabled());
+  EXPECT_EQ(drive(off, 100, 5e-3, 1e-3), 0);
+  EXPECT_EQ(off.threads(), 4);
+}
+
+TEST(ThreadTuner, SwitchingThreadCountsBetweenStepsKeepsResultsBitIdentical) {
+  Config cfg = test::box_config(2, "cpdi", "neo_hookean");
+  cfg.bodies[0].velocity = {"3*(Y-0.5)", "-(X-0.5)"};
+  cfg.simulation.threads = 1;
+  Simulation<2> fixed(cfg);
+  for (int s = 0; s < 40; ++s) fixed.step(fixed.next_dt());
+  cfg.simulation.threads = 2;
+  Simulation<2> switching(cfg);
+  for (int s = 0; s < 40; ++s) {
+    omp_set_num_threads(s % 3 == 0 ? 1 : 2);  // a tuner's choices, at any pattern
+    switching.step(switching.next_dt());
+  }
+  omp_set_num_threads(1);  // as ctest runs this binary (OMP_NUM_THREADS=1)
+  const auto& a = fixed.particles();
+  const auto& b = switching.particles();
+  for (std::size_t p = 0; p < a.n(); ++p) {
+    ASSERT_EQ(a.position[p], b.position[p]);
+    ASSERT_EQ(a.velocity[p], b.velocity[p]);
+    ASSERT_EQ(a.kirchhoff_stress[p], b.kirchhoff_stress[p]);
+    ASSERT_EQ(a.deformation_gradient[p], b.deformation_gradient[p]);
+  }
+}
+
+}  // namespace
+}  // namespace cairn
