@@ -8,9 +8,12 @@
 #include <random>
 
 #include "cairn/grid/grid.hpp"
+#include "cairn/io/errors.hpp"
 #include "cairn/parallel/decomposition.hpp"
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/parallel/particle_transfer.hpp"
+#include "cairn/sim/simulation.hpp"
+#include "../support/config_builder.hpp"
 
 namespace cairn {
 namespace {
@@ -170,6 +173,59 @@ TEST(ParticleTransfer, TheArrayListCoversTheStruct) {
     bool a, t;
   };
   EXPECT_EQ(sizeof(Particles<3>), Particles<3>::n_arrays * sizeof(std::vector<double>) + sizeof(Scalars));
+}
+
+TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
+  // Two bodies, a displacement field and a velocity: per-rank generation (a selection by id and
+  // position, as each rank of a distributed run makes it) stores exactly the particles of the
+  // serial generation that it keeps, bit for bit, numbered as serially; the checks of the
+  // generation (overlaps, empty bodies) still count every particle.
+  Config c = test::box_config(2, "linear");
+  BodyConfig second = c.bodies[0];
+  second.name = "second";
+  second.shape.min = {0.75, 0.1};
+  second.shape.max = {0.95, 0.9};
+  second.velocity = {"3*X", "-Y"};
+  second.displacement = {"0.01*Y", "0.02*X*X"};
+  c.bodies.push_back(second);
+  const Grid<2> grid(Vec<2>::Zero(), IVec<2>::Constant(10), Vec<2>::Constant(0.1), 1, {false, false});
+  std::vector<std::unique_ptr<Material>> materials;
+  materials.push_back(make_material(c.materials[0]));
+  Particles<2> all;
+  create_particles<2>(c, grid, materials, Mode::plane_strain, all);
+  ASSERT_GT(all.n(), 100u);
+  std::vector<std::int64_t> seen;
+  const ParticleSelection<2> select = [&](std::int64_t id, std::int32_t body, const Vec<2>& X, const Vec<2>& x) {
+    seen.push_back(id);
+    const auto p = static_cast<std::size_t>(id);
+    EXPECT_EQ(body, all.body[p]);
+    EXPECT_EQ(X, all.reference_position[p]);
+    EXPECT_EQ(x, all.position[p]);
+    return x[0] > 0.5 || id % 3 == 0;
+  };
+  Particles<2> some;
+  create_particles<2>(c, grid, materials, Mode::plane_strain, some, &select);
+  ASSERT_EQ(seen.size(), all.n());  // every particle visited, in creation order
+  for (std::size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], static_cast<std::int64_t>(k));
+  std::vector<std::int32_t> kept;
+  for (std::size_t p = 0; p < all.n(); ++p)
+    if (all.position[p][0] > 0.5 || p % 3 == 0) kept.push_back(static_cast<std::int32_t>(p));
+  ASSERT_LT(kept.size(), all.n());
+  reorder_particles(all, kept);
+  ASSERT_EQ(some.n(), all.n());
+  // Every per-particle array, byte for byte (the migration's packing lists them all).
+  std::vector<std::int32_t> every(some.n());
+  std::iota(every.begin(), every.end(), 0);
+  std::vector<char> bytes_some, bytes_all;
+  pack_particles(some, every, bytes_some);
+  pack_particles(all, every, bytes_all);
+  EXPECT_TRUE(bytes_some == bytes_all);
+  // An overlap is found the same way when the overlapping particles are not stored.
+  c.bodies[1].shape.min = {0.6, 0.1};
+  Particles<2> none;
+  const ParticleSelection<2> nothing = [](std::int64_t, std::int32_t, const Vec<2>&, const Vec<2>&) { return false; };
+  EXPECT_THROW(create_particles<2>(c, grid, materials, Mode::plane_strain, none, &nothing), InputError);
+  EXPECT_EQ(none.n(), 0u);
 }
 
 }  // namespace

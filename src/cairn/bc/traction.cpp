@@ -1,6 +1,8 @@
 #include "cairn/bc/traction.hpp"
 
 #include <algorithm>
+#include <cstring>
+#include <tuple>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -12,12 +14,10 @@
 
 namespace cairn {
 
-namespace {
-
 /// Lattice site of a particle: bodies are filled on a lattice of spacing l_p0 from the grid origin.
 template <int D>
-std::int64_t lattice_key(const Vec<D>& X, const Vec<D>& origin, const Vec<D>& spacing, int axis = 0,
-                         int shift = 0) {
+std::int64_t Tractions<D>::lattice_site(const Vec<D>& X, const Vec<D>& origin, const Vec<D>& spacing, int axis,
+                                        int shift) {
   std::int64_t key = 0;
   for (int a = 0; a < D; ++a) {
     std::int64_t k = std::llround((X[a] - origin[a]) / spacing[a] - 0.5);
@@ -27,21 +27,32 @@ std::int64_t lattice_key(const Vec<D>& X, const Vec<D>& origin, const Vec<D>& sp
   return key;
 }
 
-}  // namespace
-
 template <int D>
 Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles,
                         ParticleDomain domain) {
   if (config.tractions.empty()) return;
   domain_ = domain;
-  thickness_ = D == 3 ? 1.0 : config.simulation.thickness;
-
   // Occupied lattice sites per body.
-  const std::size_t n_bodies = config.bodies.size();
-  std::vector<std::unordered_set<std::int64_t>> occupied(n_bodies);
+  std::vector<std::unordered_set<std::int64_t>> occupied(config.bodies.size());
   for (std::size_t p = 0; p < particles.n(); ++p)
-    occupied[particles.body[p]].insert(
-        lattice_key<D>(particles.reference_position[p], grid.origin(), particles.size0[p]));
+    occupied[particles.body[p]].insert(lattice_site(particles.reference_position[p], grid.origin(), particles.size0[p]));
+  select(config, grid, particles, occupied, Comm::serial());
+}
+
+template <int D>
+Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles,
+                        ParticleDomain domain, const std::vector<std::unordered_set<std::int64_t>>& occupied,
+                        const Comm& comm) {
+  if (config.tractions.empty()) return;
+  domain_ = domain;
+  select(config, grid, particles, occupied, comm);
+}
+
+template <int D>
+void Tractions<D>::select(const Config& config, const Grid<D>& grid, const Particles<D>& particles,
+                          const std::vector<std::unordered_set<std::int64_t>>& occupied, const Comm& comm) {
+  thickness_ = D == 3 ? 1.0 : config.simulation.thickness;
+  const std::size_t n_bodies = config.bodies.size();
 
   for (std::size_t k = 0; k < config.tractions.size(); ++k) {
     const TractionConfig& tc = config.tractions[k];
@@ -62,7 +73,7 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
         for (int sign = -1; sign <= 1; sign += 2) {
           const int face = 2 * a + (sign > 0 ? 1 : 0);
           if (tc.side >= 0 && tc.side != face) continue;
-          if (occupied[particles.body[p]].count(lattice_key<D>(X, grid.origin(), l0, a, sign))) continue;
+          if (occupied[particles.body[p]].count(lattice_site(X, grid.origin(), l0, a, sign))) continue;
           if (has_box) {
             Vec<D> centre = X;
             centre[a] += 0.5 * sign * l0[a];
@@ -78,6 +89,7 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
           ++load.n_faces;
         }
     }
+    load.n_faces = static_cast<std::size_t>(comm.sum(static_cast<std::int64_t>(load.n_faces)));
     if (load.n_faces == 0)
       throw InputError(tc.where.file, tc.where.line, "traction[" + std::to_string(k) + "]",
                        "a selection (body, side, box_min/box_max) holding at least one exposed particle face",
@@ -85,6 +97,26 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
     loads_.push_back(std::move(load));
   }
 
+  if (comm.parallel()) {
+    // Every rank's faces, in the serial order: by load, particle id, axis and side.
+    Comm::Buffers send(static_cast<std::size_t>(comm.size()));
+    for (auto& buffer : send) {
+      buffer.resize(faces_.size() * sizeof(Face));
+      if (!faces_.empty()) std::memcpy(buffer.data(), faces_.data(), buffer.size());
+    }
+    const Comm::Buffers recv = comm.all_to_all(send);
+    all_faces_.clear();
+    for (const auto& buffer : recv) {
+      const std::size_t first = all_faces_.size();
+      all_faces_.resize(first + buffer.size() / sizeof(Face));
+      if (!buffer.empty()) std::memcpy(static_cast<void*>(all_faces_.data() + first), buffer.data(), buffer.size());
+    }
+    std::sort(all_faces_.begin(), all_faces_.end(), [](const Face& x, const Face& y) {
+      return std::tie(x.load, x.id, x.axis, x.sign) < std::tie(y.load, y.id, y.axis, y.sign);
+    });
+    localise(particles, particles.n());
+    return;
+  }
   all_faces_ = faces_;
   // One proxy particle per face: the particle's extent along the face, none along the normal.
   points_.resize(faces_.size());

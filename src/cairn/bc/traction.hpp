@@ -39,11 +39,13 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/io/config.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/shapes/shape_family.hpp"
@@ -60,6 +62,18 @@ class Tractions {
   /// std::invalid_argument naming the traction and its line when one selects no face or its
   /// scale does not parse.
   Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles, ParticleDomain domain);
+  /// Per-rank generation (docs/parallel.md): `particles` are this rank's share, `occupied[b]`
+  /// the lattice sites (lattice_site) of body b's particles next to them, on any rank; the faces
+  /// of every rank are gathered (collective), so every rank holds the run's whole face list in
+  /// the serial order and refuses an empty selection alike.
+  Tractions(const Config& config, const Grid<D>& grid, const Particles<D>& particles, ParticleDomain domain,
+            const std::vector<std::unordered_set<std::int64_t>>& occupied, const Comm& comm);
+
+  /// Key of the lattice site of a particle at reference position X on a lattice of `spacing`
+  /// from `origin` (bodies are filled on such lattices, sim/bodies.cpp), shifted by `shift`
+  /// sites along `axis`.
+  [[nodiscard]] static std::int64_t lattice_site(const Vec<D>& X, const Vec<D>& origin, const Vec<D>& spacing,
+                                                 int axis = 0, int shift = 0);
 
   [[nodiscard]] bool empty() const { return loads_.empty(); }
   /// Number of faces loaded by traction `k`.
@@ -82,6 +96,11 @@ class Tractions {
   void localise(const Particles<D>& particles, std::size_t n_owned);
 
  private:
+  /// The selection of both constructors: faces of `particles` whose neighbouring sites are
+  /// not in `occupied`.
+  void select(const Config& config, const Grid<D>& grid, const Particles<D>& particles,
+              const std::vector<std::unordered_set<std::int64_t>>& occupied, const Comm& comm);
+
   struct Face {
     std::int32_t particle;  ///< local index
     std::int16_t axis;  ///< normal axis a

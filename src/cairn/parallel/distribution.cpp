@@ -42,12 +42,18 @@ void Distribution<D>::partition(Particles<D>& particles) {
   }
   std::vector<IVec<D>> cells(particles.n());
   for (std::size_t p = 0; p < particles.n(); ++p) cells[p] = cell_of(particles.position[p]);
+  partition_cells(cells);
+  migrate(particles);
+}
+
+template <int D>
+void Distribution<D>::partition_cells(const std::vector<IVec<D>>& cells) {
+  if (!active()) return;
   std::array<bool, D> periodic{};
   for (int a = 0; a < D; ++a) periodic[a] = whole_.periodic(a);
   decomposition_ = Decomposition<D>::bisect(comm_, whole_.n_cells(), periodic, cells);
   ++partitions_;
   band_ = -1;
-  migrate(particles);
 }
 
 template <int D>

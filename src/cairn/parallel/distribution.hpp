@@ -50,6 +50,18 @@ class Distribution {
   /// its owner (collective). `particles` holds this rank's particles (any subset: all of them
   /// after a replicated setup, a slab of a checkpoint, the current owned set).
   void partition(Particles<D>& particles);
+  /// Bisect the domain by the cells `cells` (this rank's part of a census of every particle, any
+  /// split of it over the ranks: the bisection sums the ranks' histograms) without moving
+  /// particles: per-rank generation then creates each rank's particles in place (collective).
+  void partition_cells(const std::vector<IVec<D>>& cells);
+  /// Take `particles` as this rank's owned particles (they must lie in its box, in increasing
+  /// id), as after a partition.
+  void adopt(const Particles<D>& particles) { n_owned_ = particles.n(); }
+  /// The cell that decides the owner of a particle at x (cells beyond a face count for the
+  /// boundary cell, periodic axes wrap; far outside the grid: the boundary box).
+  [[nodiscard]] IVec<D> cell_of(const Vec<D>& x) const;
+  /// The rank whose box holds the particle at x.
+  [[nodiscard]] int owner_of(const Vec<D>& x) const { return decomposition_.owner(cell_of(x)); }
   /// Largest particle count of a rank over the mean count (1 for a serial run; collective).
   [[nodiscard]] double imbalance(std::size_t n_owned) const;
   /// Send the particles that left this rank's box to their owners and take in those that
@@ -91,8 +103,6 @@ class Distribution {
   }
 
  private:
-  [[nodiscard]] IVec<D> cell_of(const Vec<D>& x) const;
-
   Comm comm_ = Comm::serial();
   Grid<D> whole_;
   Decomposition<D> decomposition_;

@@ -31,6 +31,7 @@
 #include "cairn/bc/expression.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/image.hpp"
+#include "cairn/parallel/comm.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/wls/arrangement.hpp"
@@ -96,30 +97,22 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
 
 /// Bodies sharing space: a particle of a later body inside an earlier body's shape (the mass
 /// there counts twice). An error or a warning naming both, by simulation.body_overlap.
-template <int D>
-void check_overlaps(const Config& config, const Particles<D>& particles, const std::vector<std::size_t>& first_of,
-                    const std::vector<ShapeBounds<D>>& bounds,
-                    const std::vector<std::shared_ptr<const GreyImage>>& images) {
+/// shared[b][a]: particles of body b (a > b excluded) inside the shape of body a; count[b]: the
+/// particles of body b (both counted over every generated particle, stored or not).
+inline void check_overlaps(const Config& config, const std::vector<std::vector<std::size_t>>& shared,
+                           const std::vector<std::size_t>& count) {
   for (std::size_t b = 1; b < config.bodies.size(); ++b)
     for (std::size_t a = 0; a < b; ++a) {
-      const bool apart = (bounds[a].hi.array() < bounds[b].lo.array()).any() ||
-                         (bounds[b].hi.array() < bounds[a].lo.array()).any();
-      if (apart) continue;
-      std::size_t shared = 0;
-      for (std::size_t p = first_of[b]; p < first_of[b + 1]; ++p)  // (zero-volume particles carry no mass)
-        if (particles.volume0[p] > 0.0 &&
-            inside<D>(config.bodies[a].shape, images[a].get(), particles.reference_position[p]))
-          ++shared;
-      if (shared == 0) continue;
+      if (shared[b][a] == 0) continue;
       const BodyConfig& first = config.bodies[a];
       const BodyConfig& second = config.bodies[b];
       const std::string what = fmt::format(
           "bodies '{}' ({}) and '{}' ({}) overlap: {} of the {} particles of '{}' lie inside the shape of "
           "'{}', where the mass counts twice",
-          first.name, first.where.str(), second.name, second.where.str(), shared,
-          first_of[b + 1] - first_of[b], second.name, first.name);
+          first.name, first.where.str(), second.name, second.where.str(), shared[b][a], count[b], second.name,
+          first.name);
       if (config.simulation.body_overlap == "warn") {
-        std::fprintf(stderr, "cairn: warning: %s\n", what.c_str());
+        if (Comm::world().is_root()) std::fprintf(stderr, "cairn: warning: %s\n", what.c_str());
         continue;
       }
       throw InputError(second.where.file, second.where.line, fmt::format("body[{}].shape", b),
@@ -134,9 +127,13 @@ void check_overlaps(const Config& config, const Particles<D>& particles, const s
 template <int D>
 void create_particles(const Config& config, const Grid<D>& grid,
                       const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
-                      Particles<D>& particles) {
+                      Particles<D>& particles, const ParticleSelection<D>* select) {
   const double thickness = D == 3 ? 1.0 : config.simulation.thickness;
-  std::vector<std::size_t> first_of(config.bodies.size() + 1, 0);  // particles of body b: [first_of[b], first_of[b+1])
+  const std::size_t n_bodies = config.bodies.size();
+  // Over every generated particle, stored or not (per-rank generation stores a subset).
+  std::int64_t next_id = static_cast<std::int64_t>(particles.n());
+  std::vector<std::size_t> count_of(n_bodies, 0);
+  std::vector<std::vector<std::size_t>> shared(n_bodies, std::vector<std::size_t>(n_bodies, 0));
   std::vector<ShapeBounds<D>> bounds_of;
   std::vector<std::shared_ptr<const GreyImage>> image_of;
   for (std::size_t b = 0; b < config.bodies.size(); ++b) {
@@ -177,8 +174,14 @@ void create_particles(const Config& config, const Grid<D>& grid,
     bounds_of.push_back(bounds);
     image_of.push_back(image);
 
+    // Earlier bodies whose bounds meet this one's: their shapes are checked for overlaps.
+    std::vector<std::size_t> near_bodies;
+    for (std::size_t a = 0; a < b; ++a) {
+      const bool apart = (bounds_of[a].hi.array() < bounds.lo.array()).any() ||
+                         (bounds.hi.array() < bounds_of[a].lo.array()).any();
+      if (!apart) near_bodies.push_back(a);
+    }
     // The lattice points in the bounds, axis 0 fastest (the order of a sweep of the grid).
-    const std::size_t before = particles.n();
     const LatticeBox<D> box = lattice_box<D>(bounds, grid, lp);
     std::array<long long, D> span{};
     long long total = 1;
@@ -225,8 +228,17 @@ void create_particles(const Config& config, const Grid<D>& grid,
         particle_volume = s.measure * thickness;
         particle_mass = materials[mat]->density() * particle_volume;
       }
+      // (zero-volume particles carry no mass: they make no overlap)
+      if (particle_volume > 0.0)
+        for (std::size_t a : near_bodies)
+          if (inside<D>(config.bodies[a].shape, image_of[a].get(), X)) ++shared[b][a];
+      ++count_of[b];
+      const std::int64_t id = next_id++;
+      const Vec<D> x = displacement ? Vec<D>(X + (*displacement)(X, X, 0.0)) : X;
+      if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x)) continue;
       const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
       particles.add(X, v0, particle_mass, particle_volume, lp, mat, static_cast<std::int32_t>(b));
+      particles.id.back() = id;
       {
         const std::size_t p = particles.n() - 1;
         if (particles.has_temperature) particles.temperature[p] = materials[mat]->initial_temperature();
@@ -235,7 +247,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
       }
       if (displacement) {
         const std::size_t p = particles.n() - 1;
-        particles.position[p] = X + (*displacement)(X, X, 0.0);
+        particles.position[p] = x;
         Mat3 F = Mat3::Identity();
         for (int a = 0; a < D; ++a) {
           const double h = 1e-6 * grid.cell_size()[a];
@@ -248,7 +260,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
         particles.deformation_gradient[p] = F;
       }
     }
-    if (particles.n() == before) {
+    if (count_of[b] == 0) {
       std::string spacing;
       for (int a = 0; a < D; ++a) spacing += fmt::format("{}{:.6g}", a ? ", " : "", lp[a]);
       throw InputError(
@@ -262,9 +274,8 @@ void create_particles(const Config& config, const Grid<D>& grid,
                                        fmt::join(std::vector<double>(bounds.hi.begin(), bounds.hi.end()), ", "),
                                        box.count() == 0.0 ? " inside the grid" : ""));
     }
-    first_of[b + 1] = particles.n();
   }
-  check_overlaps<D>(config, particles, first_of, bounds_of, image_of);
+  check_overlaps(config, shared, count_of);
   // Initial stresses of pre-deformed bodies.
   for (std::size_t p = 0; p < particles.n(); ++p) {
     if (particles.deformation_gradient[p].isIdentity(0.0)) continue;
@@ -278,8 +289,11 @@ void create_particles(const Config& config, const Grid<D>& grid,
   (void)mode;
 }
 
-template void create_particles<1>(const Config&, const Grid<1>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<1>&);
-template void create_particles<2>(const Config&, const Grid<2>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<2>&);
-template void create_particles<3>(const Config&, const Grid<3>&, const std::vector<std::unique_ptr<Material>>&, Mode, Particles<3>&);
+template void create_particles<1>(const Config&, const Grid<1>&, const std::vector<std::unique_ptr<Material>>&, Mode,
+                                  Particles<1>&, const ParticleSelection<1>*);
+template void create_particles<2>(const Config&, const Grid<2>&, const std::vector<std::unique_ptr<Material>>&, Mode,
+                                  Particles<2>&, const ParticleSelection<2>*);
+template void create_particles<3>(const Config&, const Grid<3>&, const std::vector<std::unique_ptr<Material>>&, Mode,
+                                  Particles<3>&, const ParticleSelection<3>*);
 
 }  // namespace cairn

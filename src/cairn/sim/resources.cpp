@@ -192,7 +192,8 @@ double memory_limit_bytes(const Config& config) {
 }
 
 template <int D>
-void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n_state, int stencil_width) {
+void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n_state, int stencil_width,
+                  int ranks) {
   // Bytes per particle (particles/particles.hpp: 4 D-vectors, 3 scalars, 4 Mat3, 2 int32, the
   // material state), the simulation's per-particle scratch (3 vectors and a scalar), the
   // transfer cache (per stencil node: node and slot int32, weight, gradient; cell, count, order).
@@ -235,22 +236,25 @@ void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n
                                  body.name, n, dims, fmt::join(body.particles_per_cell, " x "));
     }
   }
-  const double bytes = particles * per_particle + nodes * per_node;
+  const double share = 1.0 / std::max(ranks, 1);  // one rank's part of a distributed run
+  const double bytes = share * (particles * per_particle + nodes * per_node);
   const double limit = memory_limit_bytes(config);
-  const bool too_many = particles > static_cast<double>(INT32_MAX);
+  const bool too_many = share * particles > static_cast<double>(INT32_MAX);
   if (bytes <= limit && !too_many) return;
 
   const std::string limit_text =
       config.simulation.memory_limit > 0.0
           ? fmt::format("simulation.memory_limit = {:.4g} GiB", config.simulation.memory_limit)
           : fmt::format("this machine's {:.4g} GiB (simulation.memory_limit = 0)", limit / gib);
-  const std::string found = fmt::format(
+  std::string found = fmt::format(
       "an estimated {:.3g} GiB: {:.3g} particles x {:.0f} bytes (largest {}) and {:.3g} grid "
       "nodes x {} field(s) x {:.0f} bytes (grid.cell_size)",
-      bytes / gib, particles, per_particle, largest_text, static_cast<double>(grid.n_nodes()), n_fields,
+      bytes / share / gib, particles, per_particle, largest_text, static_cast<double>(grid.n_nodes()), n_fields,
       per_node);
+  if (ranks > 1) found += fmt::format(", of which each of the {} MPI ranks holds about 1/{}", ranks, ranks);
   const std::string expected =
-      too_many ? fmt::format("at most {} particles (particle indices are 32-bit integers)", INT32_MAX)
+      too_many ? fmt::format("at most {} particles{} (particle indices are 32-bit integers)", INT32_MAX,
+                             ranks > 1 ? " per MPI rank" : "")
                : fmt::format("a setup that fits {}", limit_text);
   if (!too_many && nodes * per_node >= particles * per_particle)
     throw InputError(config.grid.where.file, config.grid.where.line, "grid.cell_size", expected, found);
@@ -281,6 +285,11 @@ void check_run_length(const Simulation<D>& sim) {
       c[m] = std::max(c[m], sim.materials()[m]->wave_speed(ps.deformation_gradient[p]));
       v = std::max(v, ps.velocity[p].norm());
     }
+    // Over every rank's particles (the same message on every rank).
+    c.push_back(v);
+    sim.comm().max(c.data(), static_cast<int>(c.size()));
+    v = c.back();
+    c.pop_back();
     const auto fastest = static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
     const double cfl_dt = s.cfl * sim.grid().min_cell_size() / (c.empty() ? v : c[fastest] + v);
     if (dt < cfl_dt * (1.0 - 1e-9)) {
@@ -325,7 +334,7 @@ void check_positions_in_grid(const Grid<D>& grid, const Particles<D>& particles,
   template LatticeBox<D> lattice_box<D>(const ShapeBounds<D>&, const Grid<D>&, const Vec<D>&);       \
   template void check_inside_grid<D>(const BodyConfig&, std::size_t, const ShapeBounds<D>&,          \
                                      const Grid<D>&, const Vec<D>&);                                 \
-  template void check_memory<D>(const Config&, const Grid<D>&, int, int, int);                       \
+  template void check_memory<D>(const Config&, const Grid<D>&, int, int, int, int);                  \
   template void check_run_length<D>(const Simulation<D>&);                                          \
   template void check_positions_in_grid<D>(const Grid<D>&, const Particles<D>&, const std::string&);
 CAIRN_RESOURCES(1)

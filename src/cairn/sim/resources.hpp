@@ -72,10 +72,12 @@ double memory_limit_bytes(const Config& config);
 /// Estimate the memory of grid, particles and transfer caches before anything is allocated;
 /// refuse (InputError at the key that dominates: a body's particles_per_cell or grid.cell_size)
 /// when it exceeds memory_limit_bytes(), and more particles than a 32-bit index holds.
-/// `stencil_width`: nodes per axis of one particle's stencil.
+/// `stencil_width`: nodes per axis of one particle's stencil. On `ranks` MPI ranks each rank
+/// holds about 1/ranks of the particles and nodes (docs/parallel.md, per-rank generation): the
+/// limits apply to that share.
 template <int D>
 void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n_state,
-                  int stencil_width);
+                  int stencil_width, int ranks = 1);
 
 /// Refuse a run whose end_time / first time step exceeds simulation.max_estimated_steps (unless
 /// max_steps bounds it), naming what sets the step: the material with the fastest wave speed,

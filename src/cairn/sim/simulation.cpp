@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <unordered_set>
 
 #include "cairn/contact/contact.hpp"
 #include "cairn/materials/plane_stress.hpp"
@@ -67,12 +68,39 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   particles_.has_affine = scheme_->affine();
   particles_.has_temperature = config_.thermal.conduction;
   for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
-  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1);
-  create_particles<D>(config_, grid_, materials_, mode_, particles_);
+  check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1, comm.size());
+  if (comm.parallel()) {
+    // Per-rank generation (docs/parallel.md): every rank walks the bodies' particles twice and
+    // stores none of them the first time, only the cells of every size-th one (a census whose
+    // histograms, summed over the ranks, are those of all particles), bisects the domain by
+    // them, and stores only the particles of its own box the second time.
+    distribution_ = Distribution<D>(comm, whole_);
+    const auto rank = static_cast<std::int64_t>(comm.rank()), ranks = static_cast<std::int64_t>(comm.size());
+    std::vector<IVec<D>> census;
+    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t, const Vec<D>&, const Vec<D>& x) {
+      if (id % ranks == rank) census.push_back(distribution_.cell_of(x));
+      return false;
+    };
+    create_particles<D>(config_, grid_, materials_, mode_, particles_, &count);
+    distribution_.partition_cells(census);
+    std::vector<IVec<D>>().swap(census);
+    const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x) {
+      return distribution_.owner_of(x) == comm.rank();
+    };
+    create_particles<D>(config_, grid_, materials_, mode_, particles_, &mine);
+    distribution_.adopt(particles_);
+  } else {
+    create_particles<D>(config_, grid_, materials_, mode_, particles_);
+  }
   particles_.shrink_to_fit();
   for (const auto& m : materials_) material_density_.push_back(m->density());
   material_in_use_.assign(materials_.size(), 0);
   for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
+  if (comm.parallel()) {
+    std::vector<std::int64_t> in_use(material_in_use_.begin(), material_in_use_.end());
+    comm.max(in_use.data(), static_cast<int>(in_use.size()));
+    for (std::size_t m = 0; m < in_use.size(); ++m) material_in_use_[m] = static_cast<char>(in_use[m]);
+  }
   if (config_.thermal.conduction) {  // on the whole grid here; windows in allocate_nodes
     std::vector<double> k, cp;
     for (const auto& mc : config_.materials) {
@@ -84,6 +112,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   }
   double max_mass = 0.0;
   for (double m : particles_.mass) max_mass = std::max(max_mass, m);
+  max_mass = comm.max(max_mass);
   small_mass_ = 1e-15 * max_mass;  // nodes below this hold no velocity
   if (config_.contact.enabled()) {
     // Multimaterial mode: one field per material or body, side by side (contact/contact.hpp).
@@ -93,11 +122,37 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
   // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
   node_scratch_ = scheme_->full_mass() != FullMass::none || timing_ != Timing::usl;
-  // Conditions and tractions select their nodes and faces on the whole grid and every particle,
-  // so that a selection holding none is refused the same way on any number of ranks.
+  // Conditions and tractions select their nodes and faces on the whole grid and every particle
+  // (the faces gathered from every rank), so that a selection holding none is refused the same
+  // way on any number of ranks.
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
-  tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
+  if (comm.parallel() && !config_.tractions.empty()) {
+    // A face is exposed when its body has no particle in the lattice site across it, which may
+    // belong to another rank: a third walk over the bodies records which of those sites hold a
+    // particle.
+    std::vector<std::unordered_set<std::int64_t>> across(config_.bodies.size()), occupied(config_.bodies.size());
+    for (std::size_t p = 0; p < particles_.n(); ++p)
+      for (int a = 0; a < D; ++a)
+        for (int sign = -1; sign <= 1; sign += 2)
+          across[particles_.body[p]].insert(Tractions<D>::lattice_site(particles_.reference_position[p],
+                                                                      grid_.origin(), particles_.size0[p], a, sign));
+    const ParticleSelection<D> sites = [&](std::int64_t, std::int32_t body, const Vec<D>& X, const Vec<D>&) {
+      const auto b = static_cast<std::size_t>(body);
+      IVec<D> ppc;
+      for (int a = 0; a < D; ++a) ppc[a] = config_.bodies[b].particles_per_cell[a];
+      const std::int64_t key =
+          Tractions<D>::lattice_site(X, grid_.origin(), grid_.cell_size().cwiseQuotient(ppc.template cast<double>()));
+      if (across[b].count(key)) occupied[b].insert(key);
+      return false;
+    };
+    Particles<D> none;
+    none.n_state_per_particle = particles_.n_state_per_particle;
+    create_particles<D>(config_, grid_, materials_, mode_, none, &sites);
+    tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain(), occupied, comm);
+  } else {
+    tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
+  }
 
   if (config_.method.integration == "wls") {
     // The WLS method (seed 001) replaces the particle transfers; features that act through
@@ -141,16 +196,8 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   }
   check_run_length<D>(*this);
   if (comm.parallel()) {
-    // Each rank keeps the particles of its box and a window of the grid (docs/parallel.md).
-    distribution_ = Distribution<D>(comm, whole_);
-    // Every rank created every particle (the same setup, so tractions and conditions saw them
-    // all); each keeps an equal slab of them and the partition sends each to its owner.
-    const auto n = particles_.n(), rank = static_cast<std::size_t>(comm.rank()),
-               ranks = static_cast<std::size_t>(comm.size());
-    std::vector<std::int32_t> slab(n * (rank + 1) / ranks - n * rank / ranks);
-    std::iota(slab.begin(), slab.end(), static_cast<std::int32_t>(n * rank / ranks));
-    reorder_particles(particles_, slab);
-    distribution_.partition(particles_);
+    // Each rank keeps the particles of its box (generated there, above) and a window of the
+    // grid (docs/parallel.md).
     velocity_conditions_.set_comm(comm);
     reach_ = std::max(1, shape_->ghost_layers());
     grid_ = distribution_.window(whole_, reach_);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -232,10 +233,18 @@ class Simulation {
   double external_work_ = 0.0;
 };
 
-/// Fill `particles` from the [[body]] tables (sim/bodies.cpp).
+/// Which generated particles a rank stores (per-rank generation, docs/parallel.md): called for
+/// every particle the bodies generate, in creation order, with its id (its number in a serial
+/// run), body, reference position X and position x; true stores it. The generation and its
+/// checks (empty bodies, overlaps) visit every particle on every rank, so they decide alike.
+template <int D>
+using ParticleSelection = std::function<bool(std::int64_t id, std::int32_t body, const Vec<D>& X, const Vec<D>& x)>;
+
+/// Fill `particles` from the [[body]] tables (sim/bodies.cpp): all of them, or those `select`
+/// keeps (ids as in a serial run).
 template <int D>
 void create_particles(const Config& config, const Grid<D>& grid,
                       const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
-                      Particles<D>& particles);
+                      Particles<D>& particles, const ParticleSelection<D>* select = nullptr);
 
 }  // namespace cairn
