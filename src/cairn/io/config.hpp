@@ -62,6 +62,7 @@ struct MethodConfig {
   double cpdi_max_span = 2.0;     ///< CPDI guard: widest domain (cells per axis) before falling back to GIMP
   double beta = 0.99;             ///< FLIP fraction of the blend update (seed 002 Eq. 1.79)
   std::string blend_position = "grid";  ///< grid: VV = S v; projected: beta S v + (1-beta) P V
+  std::string position_update = "scheme";  ///< scheme | updated: X += S v+ dt (docs/update-schemes.md)
   double grid_damping = 0.0;      ///< alpha_g (seed 002 Eq. 1.83)
   double particle_damping = 0.0;  ///< alpha_p (seed 002 Eq. 1.83)
   double full_mass_cfl = 0.0;     ///< periodic FMPM/XPIC CFL_X; 0 = every step

@@ -969,6 +969,7 @@ void Loader::read_method(const toml::table& root, Config& cfg) {
   }
   m.beta = r.real("beta");
   m.blend_position = r.string("blend_position");
+  m.position_update = r.string("position_update");
   m.grid_damping = r.real("grid_damping");
   m.particle_damping = r.real("particle_damping");
   m.full_mass_cfl = r.real("full_mass_cfl");
@@ -1734,6 +1735,7 @@ std::string config_to_toml(const Config& c) {
     line("cpdi_max_span", real_text(m.cpdi_max_span));
     line("beta", real_text(m.beta));
     line("blend_position", toml_string(m.blend_position));
+    line("position_update", toml_string(m.position_update));
     line("grid_damping", real_text(m.grid_damping));
     line("particle_damping", real_text(m.particle_damping));
     line("full_mass_cfl", real_text(m.full_mass_cfl));

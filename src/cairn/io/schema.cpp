@@ -195,6 +195,13 @@ std::vector<KeyDecl> make_declarations() {
                  "beta S v + (1 - beta) P V (seed 002 Eq. 1.80).")
                 .by_default("\"grid\"")
                 .choices([] { return std::vector<std::string>{"grid", "projected"}; }));
+  k.push_back(Key("method", "position_update", T::string,
+                 "Particle position update: scheme = the update's own (second order for FLIP and "
+                 "XPIC, X += (S v + S v+) dt/2 for FLIP); updated = X += S v+ dt, the grid velocity "
+                 "whose gradient USL uses for F (seed 002 Eq. 1.60-1.61 for every update; stable "
+                 "under strong compression, docs/update-schemes.md).")
+                .by_default("\"scheme\"")
+                .choices([] { return std::vector<std::string>{"scheme", "updated"}; }));
   k.push_back(Key("method", "grid_damping", T::real,
                  "Grid damping alpha_g in 1/time (seed 002 Eq. 1.83).")
                 .by_default("0.0"));

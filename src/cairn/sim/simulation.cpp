@@ -982,6 +982,7 @@ void Simulation<D>::update_particles(double dt) {
   const auto& v_full = nodes_.velocity_full;
   auto& P = particles_;
   const bool contact_impulse = contact_ && contact_->impulse() && contact_->corrects_extrapolation();
+  const bool position_updated = config_.method.position_update == "updated";
   // The sum is the energy dissipated relative to the non-dissipative FLIP update (below). The
   // entry loop is compiled with and without the full-mass velocity.
   auto move = [&](auto full_tag) {
@@ -1006,7 +1007,9 @@ void Simulation<D>::update_particles(double dt) {
       }
       Effective<D> e = scheme.effective(g);
       e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
-      const Vec<D> dX = (e.VV + 0.5 * e.A_dt) * dt;
+      // position_update = "updated": X += S v+ dt, the velocity whose gradient USL gives F, so
+      // that positions and F integrate one field (docs/update-schemes.md, "Strong compression").
+      const Vec<D> dX = position_updated ? Vec<D>(g.Sv_new * dt) : Vec<D>((e.VV + 0.5 * e.A_dt) * dt);
       // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
       // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
       const Vec<D> ag_dt = g.Sv_new - g.Sv;
