@@ -1007,8 +1007,9 @@ void Simulation<D>::update_particles(double dt) {
       }
       Effective<D> e = scheme.effective(g);
       e.A_dt -= (alpha_g * g.Sv + alpha_p * g.V) * dt;  // seed 002 Eq. 1.83
-      // position_update = "updated": X += S v+ dt, the velocity whose gradient USL gives F, so
-      // that positions and F integrate one field (docs/update-schemes.md, "Strong compression").
+      // position_update = "updated": X += S v+ dt (seed 002 Eq. 1.61, the position update of
+      // modified FLIP #1), the velocity whose gradient USL gives F, so that positions and F
+      // integrate one field (docs/update-schemes.md, "Strong compression").
       const Vec<D> dX = position_updated ? Vec<D>(g.Sv_new * dt) : Vec<D>((e.VV + 0.5 * e.A_dt) * dt);
       // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
       // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
