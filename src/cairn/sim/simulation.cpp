@@ -832,6 +832,34 @@ void Simulation<D>::update_grid(double dt) {
 template <int D>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
+  if (!distributed()) {
+    // One pass: each particle's U_p is formed and scattered while its stencil is at hand (`in`
+    // is only read, so the colour sweep may gather it; the same sums in the same order).
+    for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
+    scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+      const std::int32_t off = field_offset(p);
+      double u[D] = {};
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+        for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
+      });
+      const Vec<D> U(u);
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+        out[node + off] += (S * particles_.mass[p]) * U;
+      });
+    });
+  } else {
+    lumped_projection_distributed(in, out);
+  }
+  for_each_node(n_slots(), [&](std::int32_t i) {
+    const double m = nodes_.mass[i];
+    out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
+  });
+}
+
+template <int D>
+void Simulation<D>::lumped_projection_distributed(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
+  // The ghosts' U_p come from their owners (this rank's nodes near the window's edge do not
+  // hold every particle's contribution), then the scatter as above.
   particle_vec_.resize(particles_.n());
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
     const std::int32_t off = field_offset(p);
@@ -848,10 +876,6 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
     stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
       out[node + off] += (S * particles_.mass[p]) * particle_vec_[p];
     });
-  });
-  for_each_node(n_slots(), [&](std::int32_t i) {
-    const double m = nodes_.mass[i];
-    out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
   });
 }
 

@@ -74,6 +74,7 @@ class Simulation {
   void full_mass_velocity(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, int k);
   /// out = S+ S in: grid -> particles -> grid with the lumped reverse map (seed 000 Sec. 2.1).
   void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
+  void lumped_projection_distributed(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
 
   /// Seconds spent per pipeline stage so far (name, seconds), in pipeline order.
   [[nodiscard]] std::vector<std::pair<std::string, double>> stage_times() const;

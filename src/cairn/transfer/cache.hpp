@@ -61,6 +61,10 @@ struct TransferCache {
   std::vector<std::vector<std::int32_t>> colour_blocks;  ///< blocks of each colour
   std::vector<std::int32_t> block_of;       ///< scratch: block of each particle
   std::vector<std::int32_t> cursor;         ///< scratch for the counting sort
+  /// order/block_begin/colour_blocks are the sort of block_of for these block and colour counts
+  /// (colour_blocks skips the sort while no particle changes block).
+  bool colouring_valid = false;
+  IVec<D> colouring_blocks = IVec<D>::Zero(), colouring_colours = IVec<D>::Zero();
 
   /// List layout for n particles with `slots` stencil entries each (no-op when already sized).
   void reserve(std::size_t n_particles, int slots) {
@@ -97,6 +101,7 @@ struct TransferCache {
  private:
   void resize_common() {
     n_owned = n;
+    colouring_valid = false;
     block_of.assign(n, 0);
     order.assign(n, 0);
   }

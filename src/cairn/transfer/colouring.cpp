@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <array>
+#include <vector>
 
 #include "cairn/transfer/transfer.hpp"
 
@@ -36,16 +38,38 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     return static_cast<int>(std::clamp<long long>(b, 0, n_blocks[a] - 1));
   };
 
-#pragma omp parallel for schedule(static) if (n >= parallel_min_items)
+  // Block of each cell along each axis, tabulated (no division per particle) for the cells of
+  // the grid and a margin of ghost cells on each side; cells beyond it use block_along.
+  constexpr int margin = 8;
+  std::array<std::vector<std::int32_t>, D> table;
+  for (int a = 0; a < D; ++a) {
+    const int nc = grid.n_cells()[a];
+    table[a].resize(static_cast<std::size_t>(nc + 2 * margin));
+    for (int c = -margin; c < nc + margin; ++c) table[a][c + margin] = block_along(a, c);
+  }
+  const IVec<D> n_cells = grid.n_cells();
+
+  // The sort below depends only on block_of (and the id order), so when no particle changed
+  // block since the last colouring with the same blocks, the last result stands.
+  const bool same_blocks = cache.colouring_valid && cache.id_order.empty() && cache.colouring_blocks == n_blocks &&
+                           cache.colouring_colours == n_colours;
+  int changed = same_blocks ? 0 : 1;
+#pragma omp parallel for schedule(static) reduction(| : changed) if (n >= parallel_min_items)
   for (std::int64_t p = 0; p < n; ++p) {
     const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
     int id = 0, mult = 1;
     for (int a = 0; a < D; ++a) {
-      id += block_along(a, cell[a]) * mult;
+      const int c = cell[a];
+      id += (c >= -margin && c < n_cells[a] + margin ? table[a][c + margin] : block_along(a, c)) * mult;
       mult *= n_blocks[a];
     }
+    changed |= static_cast<int>(cache.block_of[p] != id);
     cache.block_of[p] = id;
   }
+  if (!changed) return;
+  cache.colouring_valid = true;
+  cache.colouring_blocks = n_blocks;
+  cache.colouring_colours = n_colours;
 
   // Stable counting sort of particles by block.
   cache.block_begin.assign(total_blocks + 1, 0);
