@@ -22,10 +22,10 @@ namespace cairn {
 /// What a stress update sees of one particle.
 struct MaterialPoint {
   const Mat3& F;       ///< deformation gradient after this step's increment
-  const Mat3& L;       ///< velocity gradient of this step (3x3)
+  const Mat3& L;       ///< velocity gradient of this step (3x3; 0 unless Material::uses_increment())
   double* state;       ///< the particle's state variables (model-defined length)
   double dt;
-  const Mat3* dF = nullptr;       ///< this step's increment exp(L dt), when known
+  const Mat3* dF = nullptr;       ///< this step's increment exp(L dt), when known (see L)
   const SymMat3* tau_old = nullptr;  ///< Kirchhoff stress before this update, when known
   double cell_size = 0.0;         ///< grid cell size (artificial viscosity length)
   double* temperature = nullptr;  ///< the particle's temperature, updated by thermal models
@@ -65,6 +65,11 @@ class Material {
   /// Whether wave_speed depends on F (if not, the time step asks once per material, not once
   /// per particle).
   [[nodiscard]] virtual bool wave_speed_varies() const { return true; }
+
+  /// Whether update()/update_stress() read MaterialPoint::L or MaterialPoint::dF. Models that
+  /// do not (hyperelastic laws) get L = 0 and dF = I there, so the step need not assemble the
+  /// 3x3 increments for them (docs/performance.md); a model that reads them must return true.
+  [[nodiscard]] virtual bool uses_increment() const { return false; }
 
   /// General stress update; hyperelastic laws need only kirchhoff(). Path-dependent models
   /// override this and keep their history in point.state.

@@ -118,6 +118,7 @@ class MieGruneisen final : public Material {
     return std::sqrt((bulk_tangent(J) + 4.0 * G_ / 3.0) * J / density());
   }
 
+  bool uses_increment() const override { return true; }
   Mat3 update(const MaterialPoint& pt) const override {
     double* st = pt.state;
     const Mat3 dF = pt.dF ? *pt.dF : tensor_exp(pt.L * pt.dt);

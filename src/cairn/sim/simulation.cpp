@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <type_traits>
 #include <unordered_set>
 
 #include "cairn/contact/contact.hpp"
@@ -500,15 +501,20 @@ void Simulation<D>::step_stages(double dt, FullMass need, bool fmpm_velocities, 
     }
   }
   lap(3);
-  update_particles(dt);
+  if (timing_ == Timing::usl || timing_ == Timing::usavg) {
+    // The stress update reads the same stencils and grid velocities as the particle update, so
+    // it runs in the same particle loop (stencil data read once; its time counts as
+    // particle_update).
+    update_particles(dt, StressPass{fmpm_velocities ? &nodes_.velocity_full : &nodes_.velocity_new,
+                                    timing_ == Timing::usl ? dt : 0.5 * dt});
+  } else {
+    update_particles(dt);
+  }
   lap(4);
   switch (timing_) {
     case Timing::usf:
-      break;
     case Timing::usl:
     case Timing::usavg:
-      update_stresses(fmpm_velocities ? nodes_.velocity_full : nodes_.velocity_new,
-                      timing_ == Timing::usl ? dt : 0.5 * dt);
       break;
     case Timing::usl_plus:
     case Timing::usavg_plus:
@@ -994,7 +1000,7 @@ void Simulation<D>::reextrapolate_momentum() {
 }
 
 template <int D>
-void Simulation<D>::update_particles(double dt) {
+void Simulation<D>::update_particles(double dt, StressPass stress) {
   // Task 4 in the unified form (seed 002 Eq. 1.7-1.12): V += A dt, X += VV dt + A dt^2 / 2.
   const UpdateScheme<D>& scheme =
       (scheme_->full_mass() != FullMass::none && !use_full_mass_) ? *flip_ : *scheme_;
@@ -1007,19 +1013,36 @@ void Simulation<D>::update_particles(double dt) {
   auto& P = particles_;
   const bool contact_impulse = contact_ && contact_->impulse() && contact_->corrects_extrapolation();
   const bool position_updated = config_.method.position_update == "updated";
+  // With a stress pass, the velocity gradient of stress.velocity is summed in the same entry
+  // loop and the stress update (update_stress_at) follows each particle's move.
+  const std::vector<Vec<D>>* vs = stress.velocity;
+  const bool increments = uses_increments();
+  std::int64_t first_bad = -1;
+  std::string what;
   // The sum is the energy dissipated relative to the non-dissipative FLIP update (below). The
-  // entry loop is compiled with and without the full-mass velocity.
-  auto move = [&](auto full_tag) {
+  // entry loop is compiled with and without the full-mass velocity and the stress pass.
+  auto move = [&](auto full_tag, auto stress_tag) {
     constexpr bool full = decltype(full_tag)::value;
+    constexpr bool with_stress = decltype(stress_tag)::value;
     return gather_sum(cache_, [&](std::int64_t p, const auto& stencil) {
+      // grad V is summed entry by entry in this loop as gradient_of does it, except for 3D
+      // tensor stencils, whose gradient_of is sum-factorised (cheaper than per entry).
+      constexpr bool grad_in_loop =
+          with_stress && (D < 3 || std::is_same_v<std::decay_t<decltype(stencil)>, ListStencil<D>>);
       const std::int32_t off = field_offset(p);
       double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
-      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
+      double l[D][D] = {};
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
         const std::int32_t i = node + off;
         for (int a = 0; a < D; ++a) {
           sv[a] += S * v[i][a];
           sv_new[a] += S * v_new[i][a];
           if (full) sv_full[a] += S * v_full[i][a];
+        }
+        if constexpr (grad_in_loop) {
+          const Vec<D>& u = (*vs)[i];
+          for (int a = 0; a < D; ++a)
+            for (int b = 0; b < D; ++b) l[a][b] += u[a] * G[b];
         }
       });
       GridAtParticle<D> g{P.velocity[p], Vec<D>(sv), Vec<D>(sv_new), Vec<D>(sv_full), dt};
@@ -1055,12 +1078,44 @@ void Simulation<D>::update_particles(double dt) {
         P.affine_velocity[p].setZero();
         P.affine_velocity[p].template topLeftCorner<D, D>() = B * Dp.inverse();
       }
+      if constexpr (with_stress) {
+        Eigen::Matrix<double, D, D> L_D;
+        if constexpr (grad_in_loop) {
+          for (int a = 0; a < D; ++a)
+            for (int b = 0; b < D; ++b) L_D(a, b) = l[a][b];
+        } else {
+          L_D = stencil.gradient_of(*vs, off);
+        }
+        if (const char* bad = update_stress_at(p, L_D, stress.dt, increments)) record_failure(p, bad, first_bad, what);
+      }
       return dissipated;
     });
   };
-  ExactSum dissipated = use_full_mass_ ? move(std::true_type{}) : move(std::false_type{});
+  ExactSum dissipated;
+  if (vs) dissipated = use_full_mass_ ? move(std::true_type{}, std::true_type{}) : move(std::false_type{}, std::true_type{});
+  else dissipated = use_full_mass_ ? move(std::true_type{}, std::false_type{}) : move(std::false_type{}, std::false_type{});
   sum_across(distribution_.comm(), &dissipated, 1);
   dissipated_energy_ += dissipated.value();
+  if (vs)
+    collectively([&] {
+      if (first_bad >= 0) particle_failure(first_bad, what);
+    });
+}
+
+template <int D>
+bool Simulation<D>::uses_increments() const {
+  for (const auto& m : materials_)
+    if (m->uses_increment()) return true;
+  return false;
+}
+
+template <int D>
+void Simulation<D>::record_failure(std::int64_t p, const char* bad, std::int64_t& first_bad, std::string& what) {
+#pragma omp critical(cairn_failure)
+  if (first_bad < 0 || p < first_bad) {
+    first_bad = p;
+    what = bad;
+  }
 }
 
 template <int D>
@@ -1086,42 +1141,47 @@ void Simulation<D>::update_stresses(const std::vector<Vec<D>>& grid_velocity, do
   // Task 5: grad V_p = sum_i v_i (x) G_pi, dF = exp(grad V dt), F <- dF F, tau from the material.
   std::int64_t first_bad = -1;
   std::string what;
-  // The kinematics stay in D dimensions: grad V has only its D x D block, so exp(grad V dt) is
-  // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change.
-  using MatD = Eigen::Matrix<double, D, D>;
+  const bool increments = uses_increments();
   gather(cache_, [&](std::int64_t p, const auto& stencil) {
-    const std::int32_t off = field_offset(p);
-    const MatD L_D = stencil.gradient_of(grid_velocity, off);
-    const MatD dF_D = tensor_exp<D>(L_D * dt);
-    Mat3& F = particles_.deformation_gradient[p];
-    F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
-    Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
-    L.template topLeftCorner<D, D>() = L_D;
-    dF.template topLeftCorner<D, D>() = dF_D;
-    update_stress_of(static_cast<std::size_t>(p), L, dF, dt);
-    const SymMat3& tau = particles_.kirchhoff_stress[p];
-    const double J = F.determinant();
-    // One test for the common case: a sum is finite only if every term is.
-    const char* bad = nullptr;
-    if (!std::isfinite(particles_.velocity[p].sum() + particles_.position[p].sum() + tau.trace() +
-                       tau(1, 2) + tau(0, 2) + tau(0, 1)) ||
-        !(J > 0.0)) {
-      if (!particles_.velocity[p].allFinite()) bad = "velocity";
-      else if (!particles_.position[p].allFinite()) bad = "position";
-      else if (!(J > 0.0)) bad = "det F";
-      else if (!tau.allFinite()) bad = "stress";
-    }
-    if (bad) {
-#pragma omp critical(cairn_failure)
-      if (first_bad < 0 || p < first_bad) {
-        first_bad = p;
-        what = bad;
-      }
-    }
+    if (const char* bad = update_stress_at(p, stencil.gradient_of(grid_velocity, field_offset(p)), dt, increments))
+      record_failure(p, bad, first_bad, what);
   });
   collectively([&] {
     if (first_bad >= 0) particle_failure(first_bad, what);
   });
+}
+
+template <int D>
+const char* Simulation<D>::update_stress_at(std::int64_t p, const Eigen::Matrix<double, D, D>& L_D, double dt,
+                                            bool increments) {
+  // The kinematics stay in D dimensions: grad V has only its D x D block, so exp(grad V dt) is
+  // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change. The 3x3 increments are
+  // assembled only for models that read them (Material::uses_increment).
+  static const Mat3 zero = Mat3::Zero(), identity = Mat3::Identity();
+  const Eigen::Matrix<double, D, D> dF_D = tensor_exp<D>(L_D * dt);
+  Mat3& F = particles_.deformation_gradient[p];
+  F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+  if (increments) {
+    Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
+    L.template topLeftCorner<D, D>() = L_D;
+    dF.template topLeftCorner<D, D>() = dF_D;
+    update_stress_of(static_cast<std::size_t>(p), L, dF, dt);
+  } else {
+    update_stress_of(static_cast<std::size_t>(p), zero, identity, dt);
+  }
+  const SymMat3& tau = particles_.kirchhoff_stress[p];
+  // det F; below 3D F is block diagonal [[F_D, 0], [0, F_zz]].
+  const double J = D == 3 ? F.determinant() : F(2, 2) * (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0));
+  // One test for the common case: a sum is finite only if every term is.
+  if (std::isfinite(particles_.velocity[p].sum() + particles_.position[p].sum() + tau.trace() + tau(1, 2) +
+                    tau(0, 2) + tau(0, 1)) &&
+      J > 0.0)
+    return nullptr;
+  if (!particles_.velocity[p].allFinite()) return "velocity";
+  if (!particles_.position[p].allFinite()) return "position";
+  if (!(J > 0.0)) return "det F";
+  if (!tau.allFinite()) return "stress";
+  return nullptr;
 }
 
 template <int D>

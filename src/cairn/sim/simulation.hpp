@@ -65,7 +65,15 @@ class Simulation {
   /// f = -G^T V0 tau + S^T M B.
   void particles_to_grid(bool mass_and_momentum = true, bool forces = true);
   void update_grid(double dt);      ///< Task 3: p+ = p + f dt, v = m^-1 p, v+ = m^-1 p+, conditions
-  void update_particles(double dt); ///< Task 4: the scheme's A and VV move the particles
+  /// The stress update of USL/USAVG run inside the particle update's loop: grad V of `velocity`
+  /// (a grid field) with time step dt.
+  struct StressPass {
+    const std::vector<Vec<D>>* velocity = nullptr;
+    double dt = 0.0;
+  };
+  /// Task 4: the scheme's A and VV move the particles; with a stress pass, Task 5 follows each
+  /// particle's move in the same loop.
+  void update_particles(double dt, StressPass stress = {});
   /// Task 5: grad V = sum v_i (x) G_pi from `grid_velocity`, dF = exp(grad V dt), F <- dF F.
   void update_stresses(const std::vector<Vec<D>>& grid_velocity, double dt);
 
@@ -162,6 +170,11 @@ class Simulation {
   void compute_body_forces();
   /// The material's stress update of particle p into its stored stress (plane stress included).
   void update_stress_of(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
+  /// Task 5 for particle p from its velocity gradient: F, the stress and the failure checks
+  /// (returns what is not finite or not positive, or nullptr).
+  const char* update_stress_at(std::int64_t p, const Eigen::Matrix<double, D, D>& L_D, double dt, bool increments);
+  [[nodiscard]] bool uses_increments() const;  ///< any material reads MaterialPoint::L or dF
+  static void record_failure(std::int64_t p, const char* bad, std::int64_t& first_bad, std::string& what);
   [[nodiscard]] double max_signal_speed() const;
   /// Grid velocity for a stress update from the momenta in nodes_.velocity_work's source: m^-1 q
   /// with conditions, or m~_k^-1 q for FMPM.
