@@ -1032,7 +1032,16 @@ void Simulation<D>::update_particles(double dt, StressPass stress) {
       const std::int32_t off = field_offset(p);
       double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
       double l[D][D] = {};
-      stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
+      // A 3D tensor stencil whose stress velocity is v+ (FLIP-type USL): one factorised walk
+      // gives S v, S v+ and grad v+ (tensor_gather_gradient).
+      bool walked = false;
+      if constexpr (with_stress && !full && D == 3 && !grad_in_loop) {
+        if (vs == &v_new) {
+          tensor_gather_gradient(stencil, v, v_new, off, sv, sv_new, l);
+          walked = true;
+        }
+      }
+      if (!walked) stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {
         const std::int32_t i = node + off;
         for (int a = 0; a < D; ++a) {
           sv[a] += S * v[i][a];
@@ -1080,7 +1089,7 @@ void Simulation<D>::update_particles(double dt, StressPass stress) {
       }
       if constexpr (with_stress) {
         Eigen::Matrix<double, D, D> L_D;
-        if constexpr (grad_in_loop) {
+        if (grad_in_loop || walked) {
           for (int a = 0; a < D; ++a)
             for (int b = 0; b < D; ++b) L_D(a, b) = l[a][b];
         } else {

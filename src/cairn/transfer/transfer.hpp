@@ -178,6 +178,42 @@ Eigen::Matrix<double, D, D> tensor_gradient_of(const TensorStencil<D, W>& st, co
   return out;
 }
 
+/// 3D tensor stencil, two gathered fields in one sum-factorised walk: sv = sum_i S_i v_i,
+/// su = sum_i S_i u_i and l = sum_i u_i (x) G_i (the particle update with its stress pass when
+/// the stress velocity u is also a gathered field). With b_jk = sum_i w0_i u_ijk (already a sum
+/// of tensor_gradient_of), su = sum_jk w1_j w2_k b_jk, and c_jk = sum_i w0_i v_ijk gives sv the
+/// same way: 9 multiply-adds per entry instead of 8 for the two sums plus 6 for the gradient in
+/// a second walk.
+template <int W>
+void tensor_gather_gradient(const TensorStencil<3, W>& st, const std::vector<Vec<3>>& v, const std::vector<Vec<3>>& u,
+                            std::int32_t offset, double sv[3], double su[3], double l[3][3]) {
+  const std::int32_t* n = st.node;
+  const double *w0 = st.value, *d0 = w0 + W, *w1 = w0 + 2 * W, *d1 = w0 + 3 * W, *w2 = w0 + 4 * W,
+               *d2 = w0 + 5 * W;
+  for (int k = 0; k < W; ++k)
+    for (int j = 0; j < W; ++j) {
+      const std::int32_t row = n[W + j] + n[2 * W + k] + offset;
+      double a[3] = {}, b[3] = {}, c[3] = {};
+      for (int i = 0; i < W; ++i) {
+        const Vec<3>& ui = u[row + n[i]];
+        const Vec<3>& vi = v[row + n[i]];
+        for (int r = 0; r < 3; ++r) {
+          a[r] += d0[i] * ui[r];
+          b[r] += w0[i] * ui[r];
+          c[r] += w0[i] * vi[r];
+        }
+      }
+      const double wjk = w1[j] * w2[k], djk = d1[j] * w2[k], ejk = w1[j] * d2[k];
+      for (int r = 0; r < 3; ++r) {
+        l[r][0] += wjk * a[r];
+        l[r][1] += djk * b[r];
+        l[r][2] += ejk * b[r];
+        su[r] += wjk * b[r];
+        sv[r] += wjk * c[r];
+      }
+    }
+}
+
 template <int D, int W>
 template <class Fn>
 void TensorStencil<D, W>::for_each_force(const Eigen::Matrix<double, D, D>& stress, Fn&& fn) const {
