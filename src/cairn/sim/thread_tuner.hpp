@@ -21,7 +21,7 @@ class ThreadTuner {
  public:
   /// Steps of a probe not timed (the first step after a switch wakes or parks threads), steps
   /// timed at the end of a hold and of a probe, and the hold lengths.
-  static constexpr int warm_steps = 3, timed_steps = 4;
+  static constexpr int warm_steps = 1, timed_steps = 2;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
   /// A step of the full team that takes longer than this is not probed with one thread: its
   /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
