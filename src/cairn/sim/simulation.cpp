@@ -849,9 +849,8 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
         for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
       });
       const Vec<D> U(u);
-      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-        out[node + off] += (S * particles_.mass[p]) * U;
-      });
+      const double M = particles_.mass[p];  // read once (the stores to `out` might alias it)
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { out[node + off] += (S * M) * U; });
     });
   } else {
     lumped_projection_distributed(in, out);
