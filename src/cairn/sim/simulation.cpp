@@ -836,7 +836,8 @@ void Simulation<D>::update_grid(double dt) {
 }
 
 template <int D>
-void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
+template <class Finish>
+void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
   if (!distributed()) {
     // One pass: each particle's U_p is formed and scattered while its stencil is at hand (`in`
@@ -858,6 +859,7 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
   for_each_node(n_slots(), [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
+    finish(i, out[i]);
   });
 }
 
@@ -925,13 +927,11 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
     }
     return;
   }
-  for (int j = 1; j < k; ++j) {
-    lumped_projection(grid_term_, grid_proj_);
-    for_each_node(n_slots(), [&](std::int32_t i) {
-      grid_term_[i] -= grid_proj_[i];  // A^j in
+  for (int j = 1; j < k; ++j)
+    lumped_projection(grid_term_, grid_proj_, [&](std::int32_t i, const Vec<D>& projected) {
+      grid_term_[i] -= projected;  // A^j in
       out[i] += grid_term_[i];
     });
-  }
   if (method != "lumped") impose_conditions(out, when);
 }
 
@@ -959,13 +959,11 @@ void Simulation<D>::subtract_contact_term(std::vector<Vec<D>>& out, int k) {
     grid_term_[i] = impulse ? Vec<D>(contact_dv_[i] - grid_proj_[i]) : contact_dv_[i];
     out[i] -= grid_term_[i];
   });
-  for (int j = 1; j < k - 1; ++j) {
-    lumped_projection(grid_term_, grid_proj_);
-    for_each_node(n_slots(), [&](std::int32_t i) {
-      grid_term_[i] -= grid_proj_[i];
+  for (int j = 1; j < k - 1; ++j)
+    lumped_projection(grid_term_, grid_proj_, [&](std::int32_t i, const Vec<D>& projected) {
+      grid_term_[i] -= projected;
       out[i] -= grid_term_[i];
     });
-  }
 }
 
 template <int D>

@@ -81,7 +81,12 @@ class Simulation {
   /// in = m^-1 q, with velocity conditions by the selected method (seed 000 Sec. 2.4).
   void full_mass_velocity(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, int k);
   /// out = S+ S in: grid -> particles -> grid with the lumped reverse map (seed 000 Sec. 2.1).
-  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
+  /// out = S+ S in, then finish(i, out_i) in the same node loop (the caller's use of the result).
+  template <class Finish>
+  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish);
+  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
+    lumped_projection(in, out, [](std::int32_t, const Vec<D>&) {});
+  }
   void lumped_projection_distributed(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
 
   /// Seconds spent per pipeline stage so far (name, seconds), in pipeline order.
