@@ -1029,13 +1029,15 @@ void Simulation<D>::update_particles(double dt, StressPass stress) {
       const std::int32_t off = field_offset(p);
       double sv[D] = {}, sv_new[D] = {}, sv_full[D] = {};  // registers (see update_stresses)
       double l[D][D] = {};
-      // A 3D tensor stencil whose stress velocity is v+ (FLIP-type USL): one factorised walk
-      // gives S v, S v+ and grad v+ (tensor_gather_gradient).
+      // A 3D tensor stencil of width 3 or more whose stress velocity is v+ (FLIP-type USL): one
+      // factorised walk gives S v, S v+ and grad v+ (tensor_gather_gradient).
       bool walked = false;
       if constexpr (with_stress && !full && D == 3 && !grad_in_loop) {
-        if (vs == &v_new) {
-          tensor_gather_gradient(stencil, v, v_new, off, sv, sv_new, l);
-          walked = true;
+        if constexpr (std::decay_t<decltype(stencil)>::width >= 3) {
+          if (vs == &v_new) {
+            tensor_gather_gradient(stencil, v, v_new, off, sv, sv_new, l);
+            walked = true;
+          }
         }
       }
       if (!walked) stencil.for_each([&](std::int32_t node, double S, const Vec<D>& G) {

@@ -68,6 +68,7 @@ struct ListStencil {
 /// G_b = prod_a (a == b ? dphi_a : phi_a)(k_a) (seed 003 Eq. 18), the products taken in axis order.
 template <int D, int W>
 struct TensorStencil {
+  static constexpr int width = W;
   const std::int32_t* node;  ///< D x W offsets
   const double* value;       ///< D x 2W: phi then dphi per axis
 
@@ -183,7 +184,7 @@ Eigen::Matrix<double, D, D> tensor_gradient_of(const TensorStencil<D, W>& st, co
 /// the stress velocity u is also a gathered field). With b_jk = sum_i w0_i u_ijk (already a sum
 /// of tensor_gradient_of), su = sum_jk w1_j w2_k b_jk, and c_jk = sum_i w0_i v_ijk gives sv the
 /// same way: 9 multiply-adds per entry instead of 8 for the two sums plus 6 for the gradient in
-/// a second walk.
+/// a second walk. Pays from W = 3 (quadratic splines); for W = 2 two walks are faster.
 template <int W>
 void tensor_gather_gradient(const TensorStencil<3, W>& st, const std::vector<Vec<3>>& v, const std::vector<Vec<3>>& u,
                             std::int32_t offset, double sv[3], double su[3], double l[3][3]) {
