@@ -19,10 +19,16 @@ namespace cairn {
 
 class ThreadTuner {
  public:
-  /// Steps of a probe not timed (the first step after a switch wakes or parks threads), steps
-  /// timed at the end of a hold and of a probe, and the hold lengths.
+  /// Steps of a probe of the full team not timed (its first step wakes the parked threads; a
+  /// probe of one thread needs no such step), steps timed at the end of a hold and of a probe,
+  /// and the hold lengths.
   static constexpr int warm_steps = 1, timed_steps = 2;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
+  /// A probe slower than the choice by more than this factor confirms the choice beyond the
+  /// noise of a few steps: the hold then grows by sure_growth instead of hold_growth, so that
+  /// the probes of a clear winner cost less (docs/performance.md, "Threads").
+  static constexpr double sure_margin = 1.25;
+  static constexpr long long sure_growth = 16;
   /// A step of the full team that takes longer than this is not probed with one thread: its
   /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
   static constexpr double long_step = 0.02;
@@ -50,7 +56,7 @@ class ThreadTuner {
     ++steps_;
     if (current_ == 1) ++single_steps_;
     ++in_phase_;
-    const long long length = probing_ ? warm_steps + timed_steps : hold_;
+    const long long length = probing_ ? probe_length() : hold_;
     if (in_phase_ > length - timed_steps) timed_ += seconds;
     if (in_phase_ < length) return;
     const double per_step = timed_ / timed_steps;
@@ -72,7 +78,8 @@ class ThreadTuner {
       chosen_ = current_;
       hold_ = first_hold;
     } else {
-      hold_ = std::min(longest_hold, std::max(first_hold, hold_ * hold_growth));
+      const long long growth = per_step > sure_margin * chosen_time_ ? sure_growth : hold_growth;
+      hold_ = std::min(longest_hold, std::max(first_hold, hold_ * growth));
     }
     current_ = chosen_;
   }
@@ -83,6 +90,9 @@ class ThreadTuner {
   }
 
  private:
+  /// Steps of the probe now running (current_ is the probed count).
+  [[nodiscard]] long long probe_length() const { return current_ == 1 ? timed_steps : warm_steps + timed_steps; }
+
   int max_ = 1;
   bool enabled_ = false;
   int chosen_ = 1, current_ = 1;
