@@ -8,6 +8,7 @@
 #include "../support/config_builder.hpp"
 #include "cairn/sim/names.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/util/parallel.hpp"
 
 namespace cairn {
 namespace {
@@ -40,6 +41,50 @@ TEST(ShapeFamiliesInParallel, EveryFamilyIsBitIdenticalForAnyThreadCount) {
       }
   }
   omp_set_num_threads(omp_get_num_procs());
+}
+
+// The particle shares of util/parallel.hpp: every index lies in exactly one thread's static
+// range, and static_owner names that thread (the scatters give a block to the owner of its
+// middle particle, the builds and gathers take the ranges).
+TEST(ParticleAffinity, StaticRangesPartitionTheParticlesAndOwnersAgree) {
+  for (const std::int64_t n : {0, 1, 2, 3, 7, 8, 100, 8000, 8001}) {
+    for (int T = 1; T <= 5; ++T) {
+      std::int64_t next = 0;
+      for (int t = 0; t < T; ++t) {
+        const auto [first, last] = static_range(n, t, T);
+        ASSERT_EQ(first, next) << n << " " << T << " " << t;
+        ASSERT_LE(last - first, n / T + 1);
+        ASSERT_GE(last - first, n / T);
+        for (std::int64_t p = first; p < last; ++p) ASSERT_EQ(static_owner(p, n, T), t) << n << " " << T << " " << p;
+        next = last;
+      }
+      ASSERT_EQ(next, n);
+    }
+  }
+}
+
+// Beyond affinity_max_particles the gathers and scatters hand out work dynamically: the results
+// stay bit-identical for any thread count there too.
+TEST(ParticleAffinity, DynamicWorkForManyParticlesIsBitIdenticalForAnyThreadCount) {
+  Config cfg = test::box_config(2, "linear", "neo_hookean");
+  cfg.grid.cell_size.assign(2, 1.0 / 300);
+  cfg.bodies[0].shape.min = {0.05, 0.05};
+  cfg.bodies[0].shape.max = {0.95, 0.95};
+  cfg.bodies[0].velocity = {"3*(Y-0.5)", "-2*(X-0.5)"};
+  std::vector<Particles<2>> results;
+  for (int threads : {1, 2}) {
+    cfg.simulation.threads = threads;
+    Simulation<2> sim(cfg);
+    ASSERT_GT(static_cast<std::int64_t>(sim.particles().n()), affinity_max_particles);
+    for (int s = 0; s < 2; ++s) sim.step(sim.next_dt());
+    results.push_back(sim.particles());
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  for (std::size_t p = 0; p < results[0].n(); ++p) {
+    ASSERT_EQ(results[1].position[p], results[0].position[p]);
+    ASSERT_EQ(results[1].velocity[p], results[0].velocity[p]);
+    ASSERT_EQ(results[1].kirchhoff_stress[p], results[0].kirchhoff_stress[p]);
+  }
 }
 
 }  // namespace

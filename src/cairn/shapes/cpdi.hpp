@@ -19,6 +19,8 @@
 // domains whose corners fall in disconnected cells (seed 000 Sec. 3.4, item 4).
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <climits>
@@ -28,6 +30,7 @@
 #include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/util/parallel.hpp"
 
 namespace cairn {
 
@@ -246,8 +249,9 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       w1[a].resize(widest);
       dw1[a].resize(widest);
     }
-#pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < n; ++p) {
+    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
+    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::int64_t p = first_p; p < last_p; ++p) {
       if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
         bad_t = std::min<std::int64_t>(bad_t, p);
         cache.count[p] = 0;

@@ -14,6 +14,8 @@
 // derivatives (derivative with respect to xi, i.e. per cell).
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <climits>
@@ -24,6 +26,7 @@
 #include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/util/parallel.hpp"
 
 namespace cairn {
 
@@ -48,8 +51,9 @@ void build_factored(const Kernel& kernel, const Grid<D>& grid, const Particles<D
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
-#pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < n; ++p) {
+    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
+    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::int64_t p = first_p; p < last_p; ++p) {
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * W];
       double* value_out = &cache.axis_value[static_cast<std::size_t>(p) * D * 2 * W];
@@ -109,8 +113,9 @@ void build_expanded(const Kernel& kernel, int width, const Grid<D>& grid, const 
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
-#pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < n; ++p) {
+    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
+    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::int64_t p = first_p; p < last_p; ++p) {
       std::array<std::array<double, max_width>, D> w{}, dw{};
       IVec<D> first;
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);

@@ -380,11 +380,15 @@ double Simulation<D>::max_signal_speed() const {
     if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
   }
   double v2_max = 0.0;
-#pragma omp parallel for reduction(max : c_max, v2_max) if (n >= parallel_min_items)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const std::int32_t m = particles_.material[p];
-    if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
-    v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
+#pragma omp parallel reduction(max : c_max, v2_max) if (n >= particle_loop_min)
+  {
+    // Each thread reads the particles it updated (util/parallel.hpp, particle affinity).
+    const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::int64_t p = first; p < last; ++p) {
+      const std::int32_t m = particles_.material[p];
+      if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
+      v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
+    }
   }
   double both[2] = {c_max, v2_max};
   distribution_.comm().max(both, 2);

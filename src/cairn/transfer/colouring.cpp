@@ -54,17 +54,21 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
   const bool same_blocks = cache.colouring_valid && cache.id_order.empty() && cache.colouring_blocks == n_blocks &&
                            cache.colouring_colours == n_colours;
   int changed = same_blocks ? 0 : 1;
-#pragma omp parallel for schedule(static) reduction(| : changed) if (n >= parallel_min_items)
-  for (std::int64_t p = 0; p < n; ++p) {
-    const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
-    int id = 0, mult = 1;
-    for (int a = 0; a < D; ++a) {
-      const int c = cell[a];
-      id += (c >= -margin && c < n_cells[a] + margin ? table[a][c + margin] : block_along(a, c)) * mult;
-      mult *= n_blocks[a];
+#pragma omp parallel reduction(| : changed) if (n >= particle_loop_min)
+  {
+    // Each thread bins the particles it built (util/parallel.hpp, particle affinity).
+    const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::int64_t p = first; p < last; ++p) {
+      const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
+      int id = 0, mult = 1;
+      for (int a = 0; a < D; ++a) {
+        const int c = cell[a];
+        id += (c >= -margin && c < n_cells[a] + margin ? table[a][c + margin] : block_along(a, c)) * mult;
+        mult *= n_blocks[a];
+      }
+      changed |= static_cast<int>(cache.block_of[p] != id);
+      cache.block_of[p] = id;
     }
-    changed |= static_cast<int>(cache.block_of[p] != id);
-    cache.block_of[p] = id;
   }
   if (!changed) return;
   cache.colouring_valid = true;

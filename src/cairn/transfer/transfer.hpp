@@ -13,6 +13,8 @@
 // the number of threads, so results are bit-identical for any OMP_NUM_THREADS.
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -274,43 +276,72 @@ std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std:
 }
 
 /// Scatter: calls fn(p, stencil) for every particle p, race-free as above; fn may add into node
-/// arrays at the stencil's nodes.
+/// arrays at the stencil's nodes. Up to affinity_max_particles particles each thread takes the
+/// blocks of each colour whose middle particle lies in its static_range (the particles it builds
+/// and gathers, util/parallel.hpp); beyond, the blocks of a colour are handed out dynamically.
 template <int D, class Fn>
 void scatter(const TransferCache<D>& cache, Fn&& fn) {
+  const auto n = static_cast<std::int64_t>(cache.n);
+  const bool affinity = n <= affinity_max_particles;
   with_stencils(cache, [&](auto stencil_of) {
+    auto run_block = [&](std::int32_t block) {
+      for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
+        const std::int32_t p = cache.order[i];
+        fn(p, stencil_of(static_cast<std::size_t>(p)));
+      }
+    };
     // One team for all colours; the barrier at the end of each colour's loop keeps them apart.
 #pragma omp parallel
-    for (const auto& blocks : cache.colour_blocks) {
-      const auto n_blocks = static_cast<std::int64_t>(blocks.size());
+    {
+      const int t = omp_get_thread_num(), T = omp_get_num_threads();
+      for (const auto& blocks : cache.colour_blocks) {
+        const auto n_blocks = static_cast<std::int64_t>(blocks.size());
+        if (affinity) {
+          for (std::int64_t b = 0; b < n_blocks; ++b) {
+            const std::int32_t block = blocks[b];
+            const std::int32_t middle = cache.order[(cache.block_begin[block] + cache.block_begin[block + 1]) / 2];
+            if (T == 1 || static_owner(middle, n, T) == t) run_block(block);
+          }
+#pragma omp barrier
+        } else {
 #pragma omp for schedule(dynamic, 1)
-      for (std::int64_t b = 0; b < n_blocks; ++b) {
-        const std::int32_t block = blocks[b];
-        for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
-          const std::int32_t p = cache.order[i];
-          fn(p, stencil_of(static_cast<std::size_t>(p)));
+          for (std::int64_t b = 0; b < n_blocks; ++b) run_block(blocks[b]);
         }
       }
     }
   });
 }
 
-/// Particles per work chunk of a gather. Fixed, so that sums taken chunk by chunk do not depend
-/// on the thread count; small, so that threads share the work evenly when one of them is slowed
-/// down by another process on its core (chunks are handed out dynamically).
+/// Particles per work chunk of a gather beyond affinity_max_particles: small, so that threads
+/// share the work evenly when one of them is slowed down by another process on its core (chunks
+/// are handed out dynamically).
 inline constexpr std::int64_t gather_chunk = 512;
 
-/// Gather: calls fn(p, stencil) for every owned particle (cache.n_owned), in parallel over
-/// chunks of particles.
+/// Calls body(first, last) on every thread for its share of the owned particles [0, n): its
+/// static_range up to affinity_max_particles (the cache's particle count decides, as in
+/// scatter), dynamically handed-out chunks beyond. Call inside a parallel region.
+template <int D, class Body>
+void share_particles(const TransferCache<D>& cache, std::int64_t n, Body&& body) {
+  if (static_cast<std::int64_t>(cache.n) <= affinity_max_particles) {
+    const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    body(first, last);
+    return;
+  }
+  const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
+#pragma omp for schedule(dynamic, 1) nowait
+  for (std::int64_t c = 0; c < n_chunks; ++c) body(c * gather_chunk, std::min(n, (c + 1) * gather_chunk));
+}
+
+/// Gather: calls fn(p, stencil) for every owned particle (cache.n_owned), in parallel
+/// (share_particles).
 template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
   with_stencils(cache, [&](auto stencil_of) {
     const auto n = static_cast<std::int64_t>(cache.n_owned);
-    const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t c = 0; c < n_chunks; ++c) {
-      const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
-      for (std::int64_t p = c * gather_chunk; p < end; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
-    }
+#pragma omp parallel
+    share_particles(cache, n, [&](std::int64_t first, std::int64_t last) {
+      for (std::int64_t p = first; p < last; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
+    });
   });
 }
 
@@ -320,17 +351,14 @@ void gather(const TransferCache<D>& cache, Fn&& fn) {
 template <int D, class Fn>
 ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
   const auto n = static_cast<std::int64_t>(cache.n_owned);
-  const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
   ExactSum total;
   with_stencils(cache, [&](auto stencil_of) {
 #pragma omp parallel
     {
       ExactSum sum;
-#pragma omp for schedule(dynamic, 1)
-      for (std::int64_t c = 0; c < n_chunks; ++c) {
-        const std::int64_t end = std::min(n, (c + 1) * gather_chunk);
-        for (std::int64_t p = c * gather_chunk; p < end; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
-      }
+      share_particles(cache, n, [&](std::int64_t first, std::int64_t last) {
+        for (std::int64_t p = first; p < last; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
+      });
 #pragma omp critical(cairn_gather_sum)
       total += sum;
     }

@@ -1,7 +1,9 @@
 // When a loop is worth a parallel region.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
 
 namespace cairn {
 
@@ -11,5 +13,37 @@ namespace cairn {
 /// (docs/performance.md, "Threads on a shared machine"). Such loops have no order-dependent
 /// sums, so the results are the same either way.
 inline constexpr std::int64_t parallel_min_items = 32768;
+
+/// Particle affinity. Every particle stage of a step (stencil build, gathers, scatters) gives a
+/// particle to the same thread while the particles are few enough for their data to stay in the
+/// cores' caches: thread t of T takes the particles of static_range(n, t, T) in the loops over
+/// particles, and in a scatter the blocks whose middle particle is its own (transfer/transfer.hpp).
+/// Data one core wrote and another reads next moves between the cores' caches, which on the
+/// development VM made the CPDI stencil build 25 % slower per particle on 2 threads than on one
+/// (docs/performance.md, "Threads"). Beyond this count the data streams from memory anyway and
+/// the loops hand out work dynamically, which keeps a team going when one of its cores is busy
+/// with another process.
+inline constexpr std::int64_t affinity_max_particles = 1 << 18;
+
+/// Per-particle loops outside the transfers (block binning, the time-step maxima) run in
+/// parallel from this many particles, each thread over its static_range: on one thread they
+/// would read every particle's data, half of which the other cores have just written.
+inline constexpr std::int64_t particle_loop_min = 4096;
+
+/// Thread t's contiguous share [first, second) of [0, n) among T threads (the first n % T threads
+/// take one more).
+inline std::pair<std::int64_t, std::int64_t> static_range(std::int64_t n, int t, int T) {
+  const std::int64_t q = n / T, r = n % T;
+  const std::int64_t begin = t * q + std::min<std::int64_t>(t, r);
+  return {begin, begin + q + (t < r ? 1 : 0)};
+}
+
+/// The thread whose static_range(n, t, T) holds index p (0 <= p < n).
+inline int static_owner(std::int64_t p, std::int64_t n, int T) {
+  const std::int64_t q = n / T, r = n % T;
+  const std::int64_t wide = r * (q + 1);  // the first r threads take q + 1 each
+  if (p < wide) return static_cast<int>(p / (q + 1));
+  return static_cast<int>(r + (p - wide) / q);
+}
 
 }  // namespace cairn
