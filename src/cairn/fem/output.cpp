@@ -130,7 +130,9 @@ void SnapshotWriter::write_xdmf() const {
       "<Xdmf Version=\"3.0\">\n  <Domain>\n"
       "    <Grid Name=\"fem\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   const std::string nn = std::to_string(n_nodes_), ne = std::to_string(n_elements_);
-  for (const auto& [time, file] : entries_) {
+  for (const auto& entry : entries_) {
+    const double time = entry.first;
+    const std::string& file = entry.second;  // a lambda below captures it (no structured binding)
     if (!fs::exists(directory_ / "snapshots" / file)) continue;
     const auto item = [&](const std::string& dims, bool integer, const std::string& set) {
       return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">snapshots/{}:{}</DataItem>",

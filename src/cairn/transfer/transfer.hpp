@@ -338,10 +338,12 @@ template <int D, class Fn>
 void gather(const TransferCache<D>& cache, Fn&& fn) {
   with_stencils(cache, [&](auto stencil_of) {
     const auto n = static_cast<std::int64_t>(cache.n_owned);
-#pragma omp parallel
-    share_particles(cache, n, [&](std::int64_t first, std::int64_t last) {
+    // Defined outside the region (clang 14 rejects a lambda inside it that names fn).
+    const auto range = [&](std::int64_t first, std::int64_t last) {
       for (std::int64_t p = first; p < last; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
-    });
+    };
+#pragma omp parallel
+    share_particles(cache, n, range);
   });
 }
 
@@ -353,12 +355,14 @@ ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
   const auto n = static_cast<std::int64_t>(cache.n_owned);
   ExactSum total;
   with_stencils(cache, [&](auto stencil_of) {
+    // Defined outside the region (clang 14 rejects a lambda inside it that names fn).
+    const auto add_range = [&](ExactSum& sum, std::int64_t first, std::int64_t last) {
+      for (std::int64_t p = first; p < last; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
+    };
 #pragma omp parallel
     {
       ExactSum sum;
-      share_particles(cache, n, [&](std::int64_t first, std::int64_t last) {
-        for (std::int64_t p = first; p < last; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
-      });
+      share_particles(cache, n, [&](std::int64_t first, std::int64_t last) { add_range(sum, first, last); });
 #pragma omp critical(cairn_gather_sum)
       total += sum;
     }
