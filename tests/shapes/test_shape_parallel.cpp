@@ -43,10 +43,9 @@ TEST(ShapeFamiliesInParallel, EveryFamilyIsBitIdenticalForAnyThreadCount) {
   omp_set_num_threads(omp_get_num_procs());
 }
 
-// The particle shares of util/parallel.hpp: every index lies in exactly one thread's static
-// range, and static_owner names that thread (the scatters give a block to the owner of its
-// middle particle, the builds and gathers take the ranges).
-TEST(ParticleAffinity, StaticRangesPartitionTheParticlesAndOwnersAgree) {
+// The particle shares of util/parallel.hpp: the threads' static ranges partition the particles
+// in order, each within one particle of n / T.
+TEST(ParticleAffinity, StaticRangesPartitionTheParticles) {
   for (const std::int64_t n : {0, 1, 2, 3, 7, 8, 100, 8000, 8001}) {
     for (int T = 1; T <= 5; ++T) {
       std::int64_t next = 0;
@@ -55,7 +54,6 @@ TEST(ParticleAffinity, StaticRangesPartitionTheParticlesAndOwnersAgree) {
         ASSERT_EQ(first, next) << n << " " << T << " " << t;
         ASSERT_LE(last - first, n / T + 1);
         ASSERT_GE(last - first, n / T);
-        for (std::int64_t p = first; p < last; ++p) ASSERT_EQ(static_owner(p, n, T), t) << n << " " << T << " " << p;
         next = last;
       }
       ASSERT_EQ(next, n);

@@ -105,6 +105,20 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     }
     cache.colour_blocks[colour].push_back(b);
   }
+  // Each colour's blocks by their middle particle, and the particle counts before each: a
+  // scatter gives thread t of T the blocks around the t-th T-quantile of the colour's particles,
+  // which are then about the particles of its static_range (util/parallel.hpp, particle
+  // affinity) and about 1/T of the colour's work.
+  const auto middle = [&](std::int32_t b) { return cache.order[(cache.block_begin[b] + cache.block_begin[b + 1]) / 2]; };
+  cache.colour_prefix.resize(total_colours);
+  for (int c = 0; c < total_colours; ++c) {
+    auto& list = cache.colour_blocks[c];
+    std::sort(list.begin(), list.end(), [&](std::int32_t a, std::int32_t b) { return middle(a) < middle(b); });
+    auto& prefix = cache.colour_prefix[c];
+    prefix.assign(list.size() + 1, 0);
+    for (std::size_t k = 0; k < list.size(); ++k)
+      prefix[k + 1] = prefix[k] + (cache.block_begin[list[k] + 1] - cache.block_begin[list[k]]);
+  }
 }
 
 template void colour_blocks<1>(const Grid<1>&, const Particles<1>&, TransferCache<1>&);

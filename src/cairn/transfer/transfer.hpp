@@ -277,8 +277,9 @@ std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std:
 
 /// Scatter: calls fn(p, stencil) for every particle p, race-free as above; fn may add into node
 /// arrays at the stencil's nodes. Up to affinity_max_particles particles each thread takes the
-/// blocks of each colour whose middle particle lies in its static_range (the particles it builds
-/// and gathers, util/parallel.hpp); beyond, the blocks of a colour are handed out dynamically.
+/// blocks around its share of each colour's particles, the colour's blocks taken in the order of
+/// their particles (about the particles it builds and gathers, util/parallel.hpp); beyond, the
+/// blocks of a colour are handed out dynamically.
 template <int D, class Fn>
 void scatter(const TransferCache<D>& cache, Fn&& fn) {
   const auto n = static_cast<std::int64_t>(cache.n);
@@ -294,13 +295,17 @@ void scatter(const TransferCache<D>& cache, Fn&& fn) {
 #pragma omp parallel
     {
       const int t = omp_get_thread_num(), T = omp_get_num_threads();
-      for (const auto& blocks : cache.colour_blocks) {
+      for (std::size_t c = 0; c < cache.colour_blocks.size(); ++c) {
+        const auto& blocks = cache.colour_blocks[c];
         const auto n_blocks = static_cast<std::int64_t>(blocks.size());
         if (affinity) {
+          // Block b goes to the thread whose T-quantile of the colour's particles holds the
+          // block's middle (blocks sorted by middle particle, colour_blocks).
+          const std::vector<std::int64_t>& prefix = cache.colour_prefix[c];
+          const std::int64_t twice_total = 2 * prefix[n_blocks];
           for (std::int64_t b = 0; b < n_blocks; ++b) {
-            const std::int32_t block = blocks[b];
-            const std::int32_t middle = cache.order[(cache.block_begin[block] + cache.block_begin[block + 1]) / 2];
-            if (T == 1 || static_owner(middle, n, T) == t) run_block(block);
+            const std::int64_t owner = T * (prefix[b] + prefix[b + 1]) / std::max<std::int64_t>(1, twice_total);
+            if (std::min<std::int64_t>(owner, T - 1) == t) run_block(blocks[b]);
           }
 #pragma omp barrier
         } else {

@@ -17,7 +17,8 @@ inline constexpr std::int64_t parallel_min_items = 32768;
 /// Particle affinity. Every particle stage of a step (stencil build, gathers, scatters) gives a
 /// particle to the same thread while the particles are few enough for their data to stay in the
 /// cores' caches: thread t of T takes the particles of static_range(n, t, T) in the loops over
-/// particles, and in a scatter the blocks whose middle particle is its own (transfer/transfer.hpp).
+/// particles, and in a scatter the blocks around its share of each colour's particles, the
+/// blocks taken in particle order (transfer/transfer.hpp).
 /// Data one core wrote and another reads next moves between the cores' caches, which on the
 /// development VM made the CPDI stencil build 25 % slower per particle on 2 threads than on one
 /// (docs/performance.md, "Threads"). Beyond this count the data streams from memory anyway and
@@ -36,14 +37,6 @@ inline std::pair<std::int64_t, std::int64_t> static_range(std::int64_t n, int t,
   const std::int64_t q = n / T, r = n % T;
   const std::int64_t begin = t * q + std::min<std::int64_t>(t, r);
   return {begin, begin + q + (t < r ? 1 : 0)};
-}
-
-/// The thread whose static_range(n, t, T) holds index p (0 <= p < n).
-inline int static_owner(std::int64_t p, std::int64_t n, int T) {
-  const std::int64_t q = n / T, r = n % T;
-  const std::int64_t wide = r * (q + 1);  // the first r threads take q + 1 each
-  if (p < wide) return static_cast<int>(p / (q + 1));
-  return static_cast<int>(r + (p - wide) / q);
 }
 
 }  // namespace cairn
