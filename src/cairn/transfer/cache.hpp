@@ -58,12 +58,12 @@ struct TransferCache {
   // Colouring: particles sorted by block; blocks of one colour share no node.
   std::vector<std::int32_t> order;          ///< particle indices grouped by block
   std::vector<std::int32_t> block_begin;    ///< n_blocks + 1 offsets into order
-  /// Blocks of each colour, in the order of their middle particle's index (the order of a
-  /// colour's blocks changes no sum: they share no node).
-  std::vector<std::vector<std::int32_t>> colour_blocks;
-  /// Per colour, particles in its blocks before each block (colour_blocks[c].size() + 1 entries):
-  /// a scatter splits each colour at these counts (transfer/transfer.hpp, scatter).
-  std::vector<std::vector<std::int64_t>> colour_prefix;
+  std::vector<std::vector<std::int32_t>> colour_blocks;  ///< blocks of each colour, by index
+  /// Per colour and block (as colour_blocks): where the block's middle lies among the colour's
+  /// particles taken block by block in the order of the blocks' middle particles, doubled
+  /// (an integer); the last entry is twice the colour's particle count. A scatter gives thread t
+  /// of T the blocks of the t-th T-quantile (transfer/transfer.hpp, scatter).
+  std::vector<std::vector<std::int64_t>> colour_rank;
   std::vector<std::int32_t> block_of;       ///< scratch: block of each particle
   std::vector<std::int32_t> cursor;         ///< scratch for the counting sort
   /// order/block_begin/colour_blocks are the sort of block_of for these block and colour counts

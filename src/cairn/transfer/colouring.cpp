@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <numeric>
 #include <vector>
 
 #include "cairn/transfer/transfer.hpp"
@@ -105,19 +106,28 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     }
     cache.colour_blocks[colour].push_back(b);
   }
-  // Each colour's blocks by their middle particle, and the particle counts before each: a
-  // scatter gives thread t of T the blocks around the t-th T-quantile of the colour's particles,
-  // which are then about the particles of its static_range (util/parallel.hpp, particle
-  // affinity) and about 1/T of the colour's work.
+  // Where each block's middle lies among its colour's particles in particle order: a scatter
+  // gives thread t of T the blocks around the t-th T-quantile, which hold about the particles of
+  // its static_range (util/parallel.hpp, particle affinity) and about 1/T of the colour's work.
+  // The blocks themselves stay in index order (node arrays are then walked in storage order).
   const auto middle = [&](std::int32_t b) { return cache.order[(cache.block_begin[b] + cache.block_begin[b + 1]) / 2]; };
-  cache.colour_prefix.resize(total_colours);
+  const auto size = [&](std::int32_t b) { return std::int64_t{cache.block_begin[b + 1] - cache.block_begin[b]}; };
+  cache.colour_rank.resize(total_colours);
+  std::vector<std::int32_t> by_middle;
   for (int c = 0; c < total_colours; ++c) {
-    auto& list = cache.colour_blocks[c];
-    std::sort(list.begin(), list.end(), [&](std::int32_t a, std::int32_t b) { return middle(a) < middle(b); });
-    auto& prefix = cache.colour_prefix[c];
-    prefix.assign(list.size() + 1, 0);
-    for (std::size_t k = 0; k < list.size(); ++k)
-      prefix[k + 1] = prefix[k] + (cache.block_begin[list[k] + 1] - cache.block_begin[list[k]]);
+    const auto& list = cache.colour_blocks[c];
+    by_middle.resize(list.size());
+    std::iota(by_middle.begin(), by_middle.end(), 0);
+    std::sort(by_middle.begin(), by_middle.end(),
+              [&](std::int32_t i, std::int32_t j) { return middle(list[i]) < middle(list[j]); });
+    auto& rank = cache.colour_rank[c];
+    rank.assign(list.size() + 1, 0);
+    std::int64_t before = 0;
+    for (const std::int32_t k : by_middle) {
+      rank[k] = 2 * before + size(list[k]);
+      before += size(list[k]);
+    }
+    rank[list.size()] = 2 * before;
   }
 }
 
