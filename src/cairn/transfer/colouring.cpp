@@ -110,10 +110,12 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
   // gives thread t of T the blocks around the t-th T-quantile, which hold about the particles of
   // its static_range (util/parallel.hpp, particle affinity) and about 1/T of the colour's work.
   // The blocks themselves stay in index order (node arrays are then walked in storage order).
+  // Only the affinity schedule reads the ranks.
+  if (n > affinity_max_particles) return;
   const auto middle = [&](std::int32_t b) { return cache.order[(cache.block_begin[b] + cache.block_begin[b + 1]) / 2]; };
   const auto size = [&](std::int32_t b) { return std::int64_t{cache.block_begin[b + 1] - cache.block_begin[b]}; };
   cache.colour_rank.resize(total_colours);
-  std::vector<std::int32_t> by_middle;
+  auto& by_middle = cache.by_middle;
   for (int c = 0; c < total_colours; ++c) {
     const auto& list = cache.colour_blocks[c];
     by_middle.resize(list.size());
