@@ -67,6 +67,9 @@ void print_summary(const cairn::RunSummary& s) {
   if (s.adaptive_threads)
     fmt::print("cairn: adaptive threads: {} of {} steps on 1 thread (simulation.adapt_threads)\n",
                s.single_thread_steps, s.steps);
+  if (s.particle_sorts > 0)
+    fmt::print("cairn: particles sorted into cell-block order {} time{} (simulation.sort_particles)\n",
+               s.particle_sorts, s.particle_sorts == 1 ? "" : "s");
   if (s.ranks > 1)
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);

@@ -197,6 +197,15 @@ ExactSum Tractions<D>::power(const std::vector<Vec<D>>& v, const std::vector<std
 }
 
 template <int D>
+void Tractions<D>::renumber(const std::vector<std::int32_t>& old_index) {
+  if (loads_.empty()) return;
+  std::vector<std::int32_t> new_index(old_index.size());
+  for (std::size_t k = 0; k < old_index.size(); ++k) new_index[static_cast<std::size_t>(old_index[k])] = static_cast<std::int32_t>(k);
+  for (auto* faces : {&faces_, &all_faces_})
+    for (Face& f : *faces) f.particle = new_index[static_cast<std::size_t>(f.particle)];
+}
+
+template <int D>
 void Tractions<D>::localise(const Particles<D>& particles, std::size_t n_owned) {
   if (loads_.empty()) return;
   const auto ids = particles.id.begin();

@@ -94,6 +94,9 @@ class Tractions {
   /// A distributed run: load the faces of this rank's particles, owned ones [0, n_owned) and
   /// ghost copies after them (each part in increasing id), keeping the setup's face order.
   void localise(const Particles<D>& particles, std::size_t n_owned);
+  /// A serial run whose particles were reordered: the particle stored at k was stored at
+  /// old_index[k] (Simulation::sort_particles). The faces and their order stay.
+  void renumber(const std::vector<std::int32_t>& old_index);
 
  private:
   /// The selection of both constructors: faces of `particles` whose neighbouring sites are

@@ -38,6 +38,7 @@ struct SimulationConfig {
   double thickness = 1.0;   ///< out-of-plane thickness in 2D; cross-section area in 1D
   int threads = 0;          ///< 0: OpenMP default
   bool adapt_threads = true;  ///< pick all threads or one from measured step times
+  bool sort_particles = true;  ///< keep large runs' particles in memory in cell-block order
   std::string units = "SI"; ///< declared unit system (labels the output; io/units.hpp)
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
   double rebalance_threshold = 0.25;  ///< MPI: repartition when max/mean particles - 1 exceeds it

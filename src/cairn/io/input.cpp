@@ -900,6 +900,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.thickness = r.real("thickness");
   s.threads = r.small_integer("threads");
   s.adapt_threads = r.boolean("adapt_threads");
+  s.sort_particles = r.boolean("sort_particles");
   s.units = r.string("units");
   s.memory_limit = r.real("memory_limit");
   s.rebalance_threshold = r.real("rebalance_threshold");
@@ -1713,6 +1714,7 @@ std::string config_to_toml(const Config& c) {
   line("thickness", real_text(s.thickness));
   line("threads", fmt::format("{}", s.threads));
   line("adapt_threads", s.adapt_threads ? "true" : "false");
+  line("sort_particles", s.sort_particles ? "true" : "false");
   line("rebalance_threshold", real_text(s.rebalance_threshold));
   line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));

@@ -111,6 +111,13 @@ std::vector<KeyDecl> make_declarations() {
                  "run with the faster (a busy machine makes a team of threads slower than one "
                  "thread); results do not depend on the thread count. false: always all threads.")
                 .by_default("true"));
+  k.push_back(Key("simulation", "sort_particles", T::boolean,
+                 "Keep the particles of a run of 32768 or more particles in memory in the order "
+                 "of the grid's cell blocks, sorted again when they have moved out of it (the "
+                 "particle-to-grid transfers then read memory in order; docs/performance.md). "
+                 "Results are bit-identical either way and output lists particles in id order. "
+                 "Runs on one MPI rank only.")
+                .by_default("true"));
   k.push_back(Key("simulation", "rebalance_threshold", T::real,
                  "Runs on several MPI ranks (docs/parallel.md): repartition the domain when the "
                  "largest particle count of a rank exceeds the mean count by more than this "

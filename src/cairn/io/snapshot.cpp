@@ -64,6 +64,15 @@ const char* xdmf_header() {
          "  <Domain>\n";
 }
 
+/// `values` in the file's particle order: the array itself, or with an `order` a copy in it.
+template <class T>
+const T* arranged(const std::vector<T>& values, const std::vector<std::int32_t>* order, std::vector<T>& copy) {
+  if (!order) return values.data();
+  copy.resize(order->size());
+  for (std::size_t p = 0; p < order->size(); ++p) copy[p] = values[static_cast<std::size_t>((*order)[p])];
+  return copy.data();
+}
+
 }  // namespace
 
 template <int D>
@@ -102,8 +111,10 @@ fs::path SnapshotWriter<D>::grid_xdmf_path() const {
 template <int D>
 void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long long step,
                               const Grid<D>* grid, const NodeField<D>* nodes,
-                              const std::vector<Vec3>* contact_normals) {
+                              const std::vector<Vec3>* contact_normals,
+                              const std::vector<std::int32_t>* order) {
   const std::size_t n = particles.n();
+  if (order && order->size() != n) throw std::invalid_argument("snapshot: the particle order has the wrong length");
   const bool with_grid = grid != nullptr && nodes != nullptr;
   if (particles.reference_position.size() != n || particles.velocity.size() != n ||
       particles.mass.size() != n || particles.volume0.size() != n ||
@@ -123,17 +134,20 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   std::vector<double> position(3 * n, 0.0), velocity(3 * n, 0.0), displacement(3 * n, 0.0);
   std::vector<double> volume(n), stress(6 * n), deformation(9 * n), pressure(n), von_mises(n);
   std::vector<std::int32_t> connectivity(n);
+  // Row p of the file holds the particle stored at q = (*order)[p].
+  const auto stored = [order](std::size_t p) { return order ? static_cast<std::size_t>((*order)[p]) : p; };
   for (std::size_t p = 0; p < n; ++p) {
+    const std::size_t q = stored(p);
     connectivity[p] = static_cast<std::int32_t>(p);
     for (int a = 0; a < D; ++a) {
-      position[3 * p + a] = particles.position[p][a];
-      velocity[3 * p + a] = particles.velocity[p][a];
-      displacement[3 * p + a] = particles.position[p][a] - particles.reference_position[p][a];
+      position[3 * p + a] = particles.position[q][a];
+      velocity[3 * p + a] = particles.velocity[q][a];
+      displacement[3 * p + a] = particles.position[q][a] - particles.reference_position[q][a];
     }
-    const Mat3& F = particles.deformation_gradient[p];
+    const Mat3& F = particles.deformation_gradient[q];
     const double J = F.determinant();
-    volume[p] = J * particles.volume0[p];
-    const Mat3 sigma = particles.kirchhoff_stress[p].full() / J;
+    volume[p] = J * particles.volume0[q];
+    const Mat3 sigma = particles.kirchhoff_stress[q].full() / J;
     const double sxx = sigma(0, 0), syy = sigma(1, 1), szz = sigma(2, 2);
     const double syz = 0.5 * (sigma(1, 2) + sigma(2, 1));
     const double sxz = 0.5 * (sigma(0, 2) + sigma(2, 0));
@@ -231,7 +245,9 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       h5::describe_dataset(gid, "velocity", vel, "velocity v", "x y z");
       h5::write_doubles_rows(gid, "displacement", displacement.data(), rows, 3, z);
       h5::describe_dataset(gid, "displacement", length, "x - X (current minus reference position)", "x y z");
-      h5::write_doubles_rows(gid, "mass", particles.mass.data(), rows, 0, z);
+      std::vector<double> doubles;  // arranged() copies, one array at a time
+      std::vector<std::int32_t> ints;
+      h5::write_doubles_rows(gid, "mass", arranged(particles.mass, order, doubles), rows, 0, z);
       h5::describe_dataset(gid, "mass", mass_unit, "particle mass (per unit thickness times the thickness in 2D)");
       h5::write_doubles_rows(gid, "volume", volume.data(), rows, 0, z);
       h5::describe_dataset(gid, "volume", meta_.unit(Quantity::volume), "current volume det(F) V0");
@@ -254,14 +270,16 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       h5::describe_dataset(gid, "von_mises", stress_unit, "von Mises equivalent stress of sigma");
       std::vector<double> zero;  // runs without a thermal model store no temperatures
       if (particles.temperature.size() != n) zero.assign(n, 0.0);
-      h5::write_doubles_rows(gid, "temperature", zero.empty() ? particles.temperature.data() : zero.data(), rows, 0, z);
+      h5::write_doubles_rows(gid, "temperature", zero.empty() ? arranged(particles.temperature, order, doubles) : zero.data(),
+                             rows, 0, z);
       h5::describe_dataset(gid, "temperature", meta_.unit(Quantity::temperature), "temperature");
-      h5::write_ints_rows(gid, "material", particles.material.data(), rows, z);
+      h5::write_ints_rows(gid, "material", arranged(particles.material, order, ints), rows, z);
       h5::describe_dataset(gid, "material", "1", "index into /material_names");
-      h5::write_ints_rows(gid, "body", particles.body.data(), rows, z);
+      h5::write_ints_rows(gid, "body", arranged(particles.body, order, ints), rows, z);
       h5::describe_dataset(gid, "body", "1", "index into /body_names");
       if (particles.id.size() == n) {
-        h5::write_int64s_rows(gid, "id", particles.id.data(), rows, z);
+        std::vector<std::int64_t> ids;
+        h5::write_int64s_rows(gid, "id", arranged(particles.id, order, ids), rows, z);
         h5::describe_dataset(gid, "id", "1", "the particle's number (creation order), on any number of MPI ranks");
       }
       h5::write_ints_rows(gid, "connectivity", connectivity.data(), rows, z);

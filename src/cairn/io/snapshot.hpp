@@ -69,11 +69,14 @@ class SnapshotWriter {
   /// index files. If both `grid` and `nodes` are given, node mass and velocity are written too
   /// (node_velocity is NodeField::velocity_new, the grid velocity after the last update).
   /// `contact_normals` (multimaterial runs, one per node, zero away from contact nodes) adds
-  /// /grid/contact_normal.
+  /// /grid/contact_normal. `order` lists the storage indices in the order to write them (a serial
+  /// run whose particles are kept in cell-block order writes them in id order; null: storage
+  /// order).
   /// Throws std::runtime_error on I/O failure, std::invalid_argument on inconsistent sizes.
   void write(const Particles<D>& particles, double time, long long step,
              const Grid<D>* grid = nullptr, const NodeField<D>* nodes = nullptr,
-             const std::vector<Vec3>* contact_normals = nullptr);
+             const std::vector<Vec3>* contact_normals = nullptr,
+             const std::vector<std::int32_t>* order = nullptr);
 
   /// Index the next write() uses in its file name.
   [[nodiscard]] int next_index() const { return next_index_; }

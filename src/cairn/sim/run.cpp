@@ -273,6 +273,7 @@ class Runner {
     summary.stage_seconds = sim_.stage_times();
     summary.adaptive_threads = tuner.enabled();
     summary.single_thread_steps = tuner.single_thread_steps();
+    summary.particle_sorts = sim_.particle_sorts();
     if (const auto* c = sim_.contact()) {
       summary.contact_prepare_seconds = c->prepare_seconds();
       summary.contact_fit_seconds = c->fit_seconds();
@@ -373,10 +374,10 @@ class Runner {
       std::vector<Vec3> normals;
       if (sim_.contact()) sim_.contact()->node_normals(normals);
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &nodes,
-                       sim_.contact() ? &normals : nullptr);
+                       sim_.contact() ? &normals : nullptr, sim_.id_order());
     }
     else
-      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), nullptr, nullptr, nullptr, sim_.id_order());
     // The regions of the last step (none before the first step).
     if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
@@ -429,7 +430,8 @@ class Runner {
     std::string saved;
     try {
       SnapshotWriter<D> failure(dir_, "failure", meta_, comm_);
-      failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1);
+      failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1, nullptr, nullptr, nullptr,
+                    sim_.id_order());
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
       saved = "; the failed state could not be written";

@@ -34,6 +34,7 @@ struct RunSummary {
   /// steps it ran on one thread.
   bool adaptive_threads = false;
   long long single_thread_steps = 0;
+  long long particle_sorts = 0;  ///< sorts into cell-block order (simulation.sort_particles)
   /// Multimaterial runs: seconds in contact preparation (of which normal/separation fits) and
   /// corrections (inside the stages above), and contact nodes summed over the steps.
   double contact_prepare_seconds = 0.0, contact_fit_seconds = 0.0, contact_correct_seconds = 0.0;

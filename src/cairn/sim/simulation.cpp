@@ -203,6 +203,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     reach_ = std::max(1, shape_->ghost_layers());
     grid_ = distribution_.window(whole_, reach_);
   }
+  keep_particles_sorted(true);
   allocate_nodes();
   if (wls_) {
     // The initial node fields and integration regions, so that output at t = 0 shows them.
@@ -226,8 +227,7 @@ void Simulation<D>::allocate_nodes() {
     contact_impulse_.assign(n_slots(), Vec<D>::Zero());
     totals_.mass.assign(grid_.n_nodes(), 0.0);
     totals_.momentum.assign(grid_.n_nodes(), Vec<D>::Zero());
-    field_offset_.resize(particles_.n());
-    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+    compute_field_offsets();
   }
   if (!grid_.is_whole()) {
     conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
@@ -266,16 +266,10 @@ void Simulation<D>::collectively(Fn&& fn) {
   try {
     fn();
   } catch (const SimulationFailure& f) {
-    // Name the particle by its id, the number a serial run gives it.
-    const std::int64_t p = f.particle();
-    key = p >= 0 && static_cast<std::size_t>(p) < particles_.n() ? particles_.id[static_cast<std::size_t>(p)] : -1;
-    message = f.what();
-    quantity = f.quantity();
-    if (p >= 0) {
-      const std::string local = "particle " + std::to_string(p);
-      if (const auto at = message.find(local); at != std::string::npos)
-        message.replace(at, local.size(), "particle " + std::to_string(key));
-    }
+    const SimulationFailure named = named_by_id(f);
+    key = named.particle();
+    message = named.what();
+    quantity = named.quantity();
   }
   const std::int64_t first = comm.min(key);
   if (first == none) return;
@@ -284,6 +278,78 @@ void Simulation<D>::collectively(Fn&& fn) {
   comm.broadcast(quantity, root);
   distribution_.drop_ghosts(particles_);
   throw SimulationFailure(first, quantity, message);
+}
+
+template <int D>
+SimulationFailure Simulation<D>::named_by_id(const SimulationFailure& f) const {
+  // Name the particle by its id, the number a serial run in creation order gives it (-1: no
+  // particle of this rank).
+  const std::int64_t p = f.particle();
+  const std::int64_t id =
+      p >= 0 && static_cast<std::size_t>(p) < particles_.id.size() ? particles_.id[static_cast<std::size_t>(p)] : -1;
+  std::string message = f.what();
+  if (p >= 0) {
+    const std::string local = "particle " + std::to_string(p);
+    if (const auto at = message.find(local); at != std::string::npos)
+      message.replace(at, local.size(), "particle " + std::to_string(id));
+  }
+  return {id, f.quantity(), message};
+}
+
+template <int D>
+void Simulation<D>::compute_field_offsets() {
+  if (!contact_) return;
+  field_offset_.resize(particles_.n());
+  for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+}
+
+template <int D>
+void Simulation<D>::keep_particles_sorted(bool setup) {
+  // Particle order (docs/architecture.md): a serial run keeps its particles in memory in the
+  // colouring's block order, within a block in id order. Every scatter adds a block's particles
+  // in id order whatever their storage order (transfer/colouring.cpp), and every other particle
+  // stage works particle by particle or sums exactly, so the results do not change by a bit.
+  const std::size_t n = particles_.n();
+  if (!config_.simulation.sort_particles || distributed() || wls_ || n < sort_min_particles ||
+      particles_.id.size() != n)
+    return;
+  TransferCache<D> fresh;  // the setup's colouring: blocks of the preferred width (no stencils yet)
+  const TransferCache<D>* coloured = &cache_;
+  if (setup) {
+    fresh.n = fresh.n_owned = n;
+    fresh.block_of.assign(n, 0);
+    fresh.order.assign(n, 0);
+    fresh.id_order = cache_.id_order;
+    colour_blocks(grid_, particles_, fresh);
+    coloured = &fresh;
+  } else if (!cache_.colouring_valid || cache_.order.size() != n) {
+    return;
+  }
+  // Runs of consecutive storage indices in the colouring's order: sorted, a block is one run
+  // (and a particle that changed block since splits one).
+  const std::vector<std::int32_t>& order = coloured->order;
+  std::size_t breaks = 0;
+  for (std::size_t k = 1; k < n; ++k) breaks += static_cast<std::size_t>(order[k] != order[k - 1] + 1);
+  if (breaks * sort_run < n) return;
+  reorder_particles(particles_, order);  // the particle stored at k was at order[k]
+  tractions_.renumber(order);
+  // The storage indices in id order: ids are 0 .. n-1 in a serial run (any other numbering sorts).
+  std::vector<std::int32_t>& by_id = cache_.id_order;
+  by_id.assign(n, -1);
+  bool dense = true;
+  for (std::size_t k = 0; k < n && dense; ++k) {
+    const std::int64_t id = particles_.id[k];
+    dense = id >= 0 && static_cast<std::size_t>(id) < n && by_id[static_cast<std::size_t>(id)] < 0;
+    if (dense) by_id[static_cast<std::size_t>(id)] = static_cast<std::int32_t>(k);
+  }
+  if (!dense) {
+    std::iota(by_id.begin(), by_id.end(), 0);
+    std::sort(by_id.begin(), by_id.end(), [&](std::int32_t a, std::int32_t b) { return particles_.id[a] < particles_.id[b]; });
+  }
+  cache_.id_order_kept = true;
+  cache_.colouring_valid = false;  // block_of and order index the old storage
+  compute_field_offsets();
+  ++particle_sorts_;
 }
 
 template <int D>
@@ -304,10 +370,16 @@ void Simulation<D>::set_particles(Particles<D> particles) {
                      [&](std::int32_t a, std::int32_t b) { return particles_.id[a] < particles_.id[b]; });
     reorder_particles(particles_, order);
   }
-  if (contact_) {
-    field_offset_.resize(particles_.n());
-    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
+  if (!distributed() && !cache_.id_order.empty()) {
+    // The set-up particles were sorted (keep_particles_sorted): the tractions' faces go back to
+    // id order, the storage order of `particles` now, which is then sorted like the set-up's.
+    if (cache_.id_order.size() == particles_.n()) tractions_.renumber(cache_.id_order);
+    cache_.id_order.clear();
+    cache_.id_order_kept = false;
+    cache_.colouring_valid = false;
   }
+  keep_particles_sorted(true);
+  compute_field_offsets();
 }
 
 template <int D>
@@ -457,6 +529,10 @@ void Simulation<D>::step(double dt) {
 
   try {
     step_stages(dt, need, fmpm_velocities, k, lap);
+  } catch (const SimulationFailure& f) {
+    distribution_.drop_ghosts(particles_);
+    if (distributed() || cache_.id_order.empty()) throw;  // (distributed: named by collectively)
+    throw named_by_id(f);  // a sorted serial run
   } catch (...) {
     distribution_.drop_ghosts(particles_);  // a failed step leaves the owned particles only
     throw;
@@ -595,6 +671,7 @@ void Simulation<D>::build_stencils() {
   if (distributed()) {
     distribute_and_build();
   } else {
+    keep_particles_sorted(false);
     shape_->build(grid_, particles_, cache_);
   }
   colour_blocks(grid_, particles_, cache_);
@@ -658,10 +735,7 @@ void Simulation<D>::distribute_and_build() {
   cache_.n_owned = distribution_.n_owned();
   cache_.id_order = distribution_.id_order();
   tractions_.localise(particles_, distribution_.n_owned());
-  if (contact_) {
-    field_offset_.resize(particles_.n());
-    for (std::size_t p = 0; p < particles_.n(); ++p) field_offset_[p] = contact_->field_of(particles_, p) * grid_.n_nodes();
-  }
+  compute_field_offsets();
 }
 
 template <int D>

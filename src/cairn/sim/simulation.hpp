@@ -25,6 +25,7 @@
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/thermal/conduction.hpp"
 #include "cairn/transfer/cache.hpp"
+#include "cairn/util/failure.hpp"
 
 namespace cairn {
 
@@ -148,7 +149,32 @@ class Simulation {
   /// on several ranks gathered by rank 0 (collective), empty on the others.
   std::vector<std::string> take_notes();
 
+  // ---- particle order (docs/architecture.md, "Particle order") ------------------------------
+  /// Serial runs of at least this many particles keep them in memory in the colouring's
+  /// cell-block order (simulation.sort_particles): a scatter then reads each block's particles
+  /// as one run of memory instead of one short run per row of cells (3D linear block of 64 000
+  /// particles: particles-to-grid 1.75x faster, docs/performance.md). Smaller runs fit the
+  /// caches in any order.
+  static constexpr std::size_t sort_min_particles = 32768;
+  /// They are sorted again when the colouring's block order falls apart into runs of
+  /// consecutive particles shorter than this on average.
+  static constexpr std::size_t sort_run = 32;
+  /// Storage indices of the particles in id order, or null when storage order is id order
+  /// (output writes particles in this order, so files list them as a serial run always has).
+  [[nodiscard]] const std::vector<std::int32_t>* id_order() const {
+    return distributed() || cache_.id_order.empty() ? nullptr : &cache_.id_order;
+  }
+  /// How often this run sorted its particles (the setup's sort included).
+  [[nodiscard]] long long particle_sorts() const { return particle_sorts_; }
+
  private:
+  /// Sort the particles into the block order of a colouring when they are out of it: `setup`
+  /// colours them first (no stencils yet), a step start uses the last step's colouring.
+  void keep_particles_sorted(bool setup);
+  /// A serial run's failure names the particle by its id, as an unsorted run does.
+  [[nodiscard]] SimulationFailure named_by_id(const SimulationFailure& f) const;
+  /// Multimaterial: field_offset_ of every particle.
+  void compute_field_offsets();
   void setup_grid();
   /// Size every node-indexed structure for grid_ (the setup, and a distributed run's windows).
   void allocate_nodes();
@@ -250,6 +276,7 @@ class Simulation {
   double time_ = 0.0;
   long long step_ = 0;
   double external_work_ = 0.0;
+  long long particle_sorts_ = 0;
 };
 
 /// Which generated particles a rank stores (per-rank generation, docs/parallel.md): called for

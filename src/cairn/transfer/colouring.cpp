@@ -52,7 +52,8 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
 
   // The sort below depends only on block_of (and the id order), so when no particle changed
   // block since the last colouring with the same blocks, the last result stands.
-  const bool same_blocks = cache.colouring_valid && cache.id_order.empty() && cache.colouring_blocks == n_blocks &&
+  const bool same_blocks = cache.colouring_valid && (cache.id_order.empty() || cache.id_order_kept) &&
+                           cache.colouring_blocks == n_blocks &&
                            cache.colouring_colours == n_colours;
   int changed = same_blocks ? 0 : 1;
 #pragma omp parallel reduction(| : changed) if (n >= particle_loop_min)
