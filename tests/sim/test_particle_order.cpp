@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numeric>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/hdf5_util.hpp"
 #include "cairn/io/input.hpp"
+#include "cairn/parallel/particle_transfer.hpp"
 #include "cairn/sim/run.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
@@ -99,6 +102,39 @@ void expect_same(const std::map<std::int64_t, State>& a, const std::map<std::int
     ASSERT_EQ(s.F, t.F) << what << ", particle " << id;
     ASSERT_EQ(s.tau, t.tau) << what << ", particle " << id;
   }
+}
+
+// The in-place permutation moves every array (state with several values per particle too) as
+// the copying reorder does.
+TEST(ParticleOrder, InPlacePermutationMatchesTheCopyingReorder) {
+  Particles<2> a;
+  a.n_state_per_particle = 3;
+  a.has_affine = true;
+  for (int k = 0; k < 500; ++k) {
+    a.add(Vec<2>(k, -k), Vec<2>(2.0 * k, 1.0), 1.0 + k, 2.0 + k, Vec<2>(0.5, 0.25), k % 3, k % 2);
+    a.deformation_gradient.back()(0, 1) = k;
+  }
+  a.affine_velocity.assign(a.n(), Mat3::Zero());
+  for (std::size_t k = 0; k < a.n(); ++k) a.affine_velocity[k](2, 2) = static_cast<double>(k);
+  a.state.resize(3 * a.n());
+  std::iota(a.state.begin(), a.state.end(), 0.0);
+  std::vector<std::int32_t> order(a.n());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(3));
+  Particles<2> b = a;
+  reorder_particles(a, order);
+  permute_particles(b, order);
+  EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.velocity, b.velocity);
+  EXPECT_EQ(a.mass, b.mass);
+  EXPECT_EQ(a.volume0, b.volume0);
+  EXPECT_EQ(a.deformation_gradient, b.deformation_gradient);
+  EXPECT_EQ(a.affine_velocity, b.affine_velocity);
+  EXPECT_EQ(a.material, b.material);
+  EXPECT_EQ(a.body, b.body);
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_EQ(a.state, b.state);
+  for (std::size_t k = 0; k < a.n(); ++k) ASSERT_EQ(b.id[k], order[k]);
 }
 
 TEST(ParticleOrder, SortedRunsAreBitIdenticalToCreationOrder) {

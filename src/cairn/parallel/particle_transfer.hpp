@@ -6,6 +6,7 @@
 // bytes per particle (sender and receiver store the same arrays: the same run).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -81,6 +82,35 @@ void reorder_particles(Particles<D>& particles, const std::vector<std::int32_t>&
       for (int w = 0; w < width; ++w)
         out[k * width + w] = array[static_cast<std::size_t>(order[k]) * width + w];
     array.swap(out);
+  });
+}
+
+/// Reorder the particles in place (no second copy of any array): particle k becomes the old
+/// particle order[k], `order` a permutation of 0 .. n-1. Each cycle of the permutation is walked
+/// once per array, marked in a bit per particle.
+template <int D>
+void permute_particles(Particles<D>& particles, const std::vector<std::int32_t>& order) {
+  const std::size_t n = order.size();
+  std::vector<bool> done(n);
+  particles.for_each_array([&](auto& array, int width) {
+    if (width == 0) return;
+    using T = typename std::decay_t<decltype(array)>::value_type;
+    const auto w = static_cast<std::size_t>(width);
+    std::vector<T> held(w);
+    done.assign(n, false);
+    for (std::size_t start = 0; start < n; ++start) {
+      if (done[start]) continue;
+      std::copy_n(array.begin() + static_cast<std::ptrdiff_t>(start * w), w, held.begin());
+      std::size_t j = start;
+      for (;;) {
+        done[j] = true;
+        const auto from = static_cast<std::size_t>(order[j]);
+        if (from == start) break;
+        std::copy_n(array.begin() + static_cast<std::ptrdiff_t>(from * w), w, array.begin() + static_cast<std::ptrdiff_t>(j * w));
+        j = from;
+      }
+      std::copy_n(held.begin(), w, array.begin() + static_cast<std::ptrdiff_t>(j * w));
+    }
   });
 }
 

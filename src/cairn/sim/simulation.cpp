@@ -331,7 +331,7 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
   std::size_t breaks = 0;
   for (std::size_t k = 1; k < n; ++k) breaks += static_cast<std::size_t>(order[k] != order[k - 1] + 1);
   if (breaks * sort_run < n) return;
-  reorder_particles(particles_, order);  // the particle stored at k was at order[k]
+  permute_particles(particles_, order);  // the particle stored at k was at order[k]
   tractions_.renumber(order);
   // The storage indices in id order: ids are 0 .. n-1 in a serial run (any other numbering sorts).
   std::vector<std::int32_t>& by_id = cache_.id_order;
