@@ -98,10 +98,15 @@ constexpr int ipow(int base, int exponent) { return exponent == 0 ? 1 : base * i
 
 /// Fixed node box of the common case: every corner's first node along each axis is lo or lo + 1,
 /// so the box is (n_nodes + 1)^D with compile-time strides. Each entry accumulates
-/// (S, G) as one (D+1)-vector, so a corner's contribution N (1/2^D, g_c) is one vector update.
+/// (G, S) as one vector, so a corner's contribution N (g_c, 1/2^D) is one vector update.
 template <int D, class Fn>
 struct FixedBox {
-  using Entry = Eigen::Matrix<double, D + 1, 1>;
+  // (G, S) padded to an even count of doubles: every load of an entry (the accumulation's, and
+  // G and S in compact_fixed) then reads whole 16-byte halves as they were stored. With (S, G) in
+  // 3 doubles, G straddled two stores and every load of it missed store forwarding (the
+  // compaction took 20 of 67 ns per particle in BM_Stencil2D/cpdi; docs/performance.md).
+  static constexpr int entry_size = (D + 2) / 2 * 2;
+  using Entry = Eigen::Matrix<double, entry_size, 1>;
   static constexpr int width = Fn::n_nodes + 1;
   static constexpr int size = ipow(width, D);
   std::array<Entry, size> acc;
@@ -120,8 +125,9 @@ void accumulate_fixed(const Domain<D>& dom, const std::array<Vec<D>, (1 << D)>& 
   // it never wait on the scalar stores that build them.
   std::array<Entry, n_corners> update;
   for (int c = 0; c < n_corners; ++c) {
-    update[c][0] = 1.0 / n_corners;
-    update[c].template tail<D>() = g[c];
+    update[c].setZero();
+    update[c].template head<D>() = g[c];
+    update[c][D] = 1.0 / n_corners;
   }
   for (Entry& e : box.acc) e.setZero();
   for (int c = 0; c < n_corners; ++c) {
@@ -174,11 +180,11 @@ int compact_fixed(const FixedBox<D, Fn>& box,
     // (which entries vanish varies from particle to particle, so a branch mispredicts often).
     for (int i = 0; i < W; ++i) {
       const auto& e = box.acc[row * W + i];
-      const bool keep = e[0] != 0.0;
+      const bool keep = e[D] != 0.0;
       outside |= keep & (row_outside | (offset[0][i] < 0));
       node[used] = row_node + offset[0][i];
-      S[used] = e[0];
-      G[used] = e.template tail<D>();
+      S[used] = e[D];
+      G[used] = e.template head<D>();
       used += keep;
     }
   }
