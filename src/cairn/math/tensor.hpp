@@ -31,7 +31,7 @@ inline const double small_limit = threshold[7];
 /// above (no data-dependent loop), evaluated Paterson-Stockmeyer style on A^2 and A^3 so that
 /// degree 4 costs 2 matrix products, degree 6 three, degree 7 four (the plain series needs m - 1).
 template <int N>
-Eigen::Matrix<double, N, N> exp_small(const Eigen::Matrix<double, N, N>& A, double b) {
+[[gnu::always_inline]] inline Eigen::Matrix<double, N, N> exp_small(const Eigen::Matrix<double, N, N>& A, double b) {
   using M = Eigen::Matrix<double, N, N>;
   int m = 1;
   for (int k = 1; k < 7; ++k) m += b > threshold[k];  // branch-free: m = 1 .. 7
@@ -58,30 +58,15 @@ Eigen::Matrix<double, N, N> exp_small(const Eigen::Matrix<double, N, N>& A, doub
   }
 }
 
-}  // namespace exp_detail
-
-/// exp(A) for an N x N matrix (N = 1, 2, 3) by scaling and squaring of a Taylor series run to
-/// round-off: exp(A) = (exp(A / 2^s))^(2^s) with s chosen so that b = |A|_inf / 2^s <= 1/2, and
-/// the series sum_k B^k / k! taken until the bound b^k / k! on its last term is below 1e-17 (the
-/// sum is at least 1 - b >= 1/2 in norm). The term count comes from that scalar bound, not from
-/// the terms themselves, so the loop does no matrix reductions, and 1/k is a multiplication. For
-/// the small increments of a stable MPM step (|grad V dt| <= 0.028) exp_small is used instead:
-/// a polynomial of degree 1 .. 7 with 0 .. 4 matrix products, its degree chosen without a
-/// data-dependent loop (that loop took a third of a 3D linear-elastic step). Both are several
-/// times cheaper than a general Pade evaluation with its solve, and exact to round-off;
-/// still correct for large arguments (tested against Eigen's Pade-based MatrixFunctions). A 2D
-/// step calls it with N = 2: exp of a block-diagonal [[A, 0], [0, 0]] is [[exp A, 0], [0, 1]].
+/// Scaling and squaring for |A|_inf = norm > small_limit (see tensor_exp), out of line.
 template <int N>
-Eigen::Matrix<double, N, N> tensor_exp(const Eigen::Matrix<double, N, N>& a) {
+[[gnu::noinline]] Eigen::Matrix<double, N, N> exp_large(const Eigen::Matrix<double, N, N>& a, double norm) {
   using M = Eigen::Matrix<double, N, N>;
   static constexpr double inverse[] = {0.0,        1.0,        1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,
                                        1.0 / 6,    1.0 / 7,    1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11,
                                        1.0 / 12,   1.0 / 13,   1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17,
                                        1.0 / 18,   1.0 / 19,   1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23,
                                        1.0 / 24,   1.0 / 25,   1.0 / 26, 1.0 / 27, 1.0 / 28, 1.0 / 29};
-  const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
-  if (!std::isfinite(norm)) return M::Constant(std::numeric_limits<double>::quiet_NaN());
-  if (norm <= exp_detail::small_limit) return exp_detail::exp_small<N>(a, norm);
   int s = 0;
   if (norm > 0.5) s = static_cast<int>(std::ceil(std::log2(norm / 0.5)));
   const double scale = s > 0 ? std::ldexp(1.0, -s) : 1.0;
@@ -97,6 +82,32 @@ Eigen::Matrix<double, N, N> tensor_exp(const Eigen::Matrix<double, N, N>& a) {
   }
   for (int i = 0; i < s; ++i) sum = (sum * sum).eval();
   return sum;
+}
+
+}  // namespace exp_detail
+
+/// exp(A) for an N x N matrix (N = 1, 2, 3) by scaling and squaring of a Taylor series run to
+/// round-off: exp(A) = (exp(A / 2^s))^(2^s) with s chosen so that b = |A|_inf / 2^s <= 1/2, and
+/// the series sum_k B^k / k! taken until the bound b^k / k! on its last term is below 1e-17 (the
+/// sum is at least 1 - b >= 1/2 in norm). The term count comes from that scalar bound, not from
+/// the terms themselves, so the loop does no matrix reductions, and 1/k is a multiplication. For
+/// the small increments of a stable MPM step (|grad V dt| <= 0.028) exp_small is used instead:
+/// a polynomial of degree 1 .. 7 with 0 .. 4 matrix products, its degree chosen without a
+/// data-dependent loop (that loop took a third of a 3D linear-elastic step). Both are several
+/// times cheaper than a general Pade evaluation with its solve, and exact to round-off;
+/// still correct for large arguments (tested against Eigen's Pade-based MatrixFunctions). A 2D
+/// step calls it with N = 2: exp of a block-diagonal [[A, 0], [0, 0]] is [[exp A, 0], [0, 1]].
+///
+/// The common path is inlined into its caller: passed through memory, a matrix the caller has
+/// just stored element by element was reloaded in 16-byte halves, each straddling two stores (a
+/// store-forwarding stall, 40 % of the function in a 3D profile; docs/performance.md).
+template <int N>
+[[gnu::always_inline]] inline Eigen::Matrix<double, N, N> tensor_exp(const Eigen::Matrix<double, N, N>& a) {
+  using M = Eigen::Matrix<double, N, N>;
+  const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
+  if (!std::isfinite(norm)) return M::Constant(std::numeric_limits<double>::quiet_NaN());
+  if (norm <= exp_detail::small_limit) return exp_detail::exp_small<N>(a, norm);
+  return exp_detail::exp_large<N>(a, norm);
 }
 
 /// The 3x3 case, also for matrix expressions (tensor_exp(L * dt)).
