@@ -1143,11 +1143,12 @@ void Simulation<D>::update_particles(double dt, StressPass stress) {
       // position_update = "updated": X += S v+ dt (seed 002 Eq. 1.61, the position update of
       // modified FLIP #1), the velocity whose gradient USL gives F, so that positions and F
       // integrate one field (docs/update-schemes.md, "Strong compression").
-      const Vec<D> dX = position_updated ? Vec<D>(g.Sv_new * dt) : Vec<D>((e.VV + 0.5 * e.A_dt) * dt);
+      const Vec<D> moved = position_updated ? g.Sv_new : Vec<D>(e.VV + 0.5 * e.A_dt);  // dX / dt
+      const Vec<D> dX = moved * dt;
       // Dissipated energy relative to the non-dissipative FLIP update, seed 002 Eq. 1.44-1.46:
       // M Sa dt . (Sv + Sa dt / 2) - M dV . dX / dt. (Eq. 1.50 is the same only when VV = Sv.)
       const Vec<D> ag_dt = g.Sv_new - g.Sv;
-      const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(dX / dt));
+      const double dissipated = P.mass[p] * (ag_dt.dot(g.Sv + 0.5 * ag_dt) - e.A_dt.dot(moved));
       const Vec<D> x_old = P.position[p];
       P.velocity[p] = g.V + e.A_dt;  // g.V is V, or V' after a contact impulse
       P.position[p] += dX;
