@@ -8,7 +8,7 @@ The block is doubled along x, so the grid (and its node arrays) grows with the p
 it would in a real refinement at fixed particles per cell.
 
   /usr/bin/python3 bench/memory_per_particle.py [--cairn build/release/cairn] [--dims 2 3]
-      [--particles 1000000 2000000] [--steps 3] [--no-checkpoint]
+      [--particles 1000000 2000000] [--steps 3] [--no-checkpoint] [--set KEY=VALUE ...]
 """
 import argparse
 import math
@@ -84,9 +84,11 @@ def write_input(path, dim, n_particles, steps, checkpoints):
     return math.prod(2 * c for c in cells)
 
 
-def peak_rss_bytes(cairn, path, outdir):
+def peak_rss_bytes(cairn, path, outdir, sets=()):
     cmd = ["/usr/bin/time", "-v", cairn, "run", path, "-t", "1", "-q",
            "--set", f"output.directory={outdir}"]
+    for s in sets:
+        cmd += ["--set", s]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
         sys.exit(f"failed: {' '.join(cmd)}\n{res.stderr}")
@@ -101,6 +103,8 @@ def main():
     ap.add_argument("--particles", type=int, nargs=2, default=[1_000_000, 2_000_000])
     ap.add_argument("--steps", type=int, default=3)
     ap.add_argument("--no-checkpoint", action="store_true", help="skip the final checkpoint")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an input override for every run (e.g. simulation.sort_particles=false)")
     args = ap.parse_args()
     cairn = os.path.abspath(args.cairn)
     with tempfile.TemporaryDirectory(prefix="cairn-memory-") as tmp:
@@ -111,7 +115,7 @@ def main():
             for n in args.particles:
                 path = os.path.join(tmp, f"memory_{dim}d_{n}.toml")
                 counts.append(write_input(path, dim, n, args.steps, not args.no_checkpoint))
-                rss.append(peak_rss_bytes(cairn, path, os.path.join(tmp, f"out_{dim}d_{n}")))
+                rss.append(peak_rss_bytes(cairn, path, os.path.join(tmp, f"out_{dim}d_{n}"), args.set))
                 print(f"{dim:>2} {counts[-1]:>10} {rss[-1] / 2**20:>13.1f}", flush=True)
             slope = (rss[1] - rss[0]) / (counts[1] - counts[0])
             print(f"{dim}D: {slope:.0f} bytes per particle (peak RSS slope)", flush=True)

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "cairn/contact/regression.hpp"
+#include "cairn/parallel/particle_transfer.hpp"
 #include "cairn/transfer/transfer.hpp"
 
 namespace cairn {
@@ -257,8 +258,12 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
   // Point clouds: the particles whose stencil holds the contact node (seed 004 Sec. 3.1, Fig. 3A).
   if (need_clouds_) {
     cloud_begin_.assign(nc + 1, 0);
-    // Particles in increasing id (a distributed run's ghosts included), as in a serial run.
-    auto particle_at = [&](std::int64_t k) { return cache.id_order.empty() ? k : std::int64_t{cache.id_order[static_cast<std::size_t>(k)]}; };
+    // Particles in increasing id (a distributed run's ghosts included; a serial run's particles
+    // kept in cell-block order), as in a serial run in creation order.
+    const std::vector<std::int32_t> sorted_ids =
+        cache.sorted_storage && cache.id_order.empty() ? storage_in_id_order(particles) : std::vector<std::int32_t>{};
+    const std::vector<std::int32_t>& ids = cache.id_order.empty() ? sorted_ids : cache.id_order;
+    auto particle_at = [&](std::int64_t k) { return ids.empty() ? k : std::int64_t{ids[static_cast<std::size_t>(k)]}; };
     for (std::int64_t p = 0; p < np; ++p)
       for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
         const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];

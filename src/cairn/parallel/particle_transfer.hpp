@@ -114,6 +114,25 @@ void permute_particles(Particles<D>& particles, const std::vector<std::int32_t>&
   });
 }
 
+/// Storage indices of the particles in increasing id (ids 0 .. n-1, a serial run's, are placed
+/// directly; any other numbering is sorted).
+template <int D>
+std::vector<std::int32_t> storage_in_id_order(const Particles<D>& particles) {
+  const std::size_t n = particles.n();
+  std::vector<std::int32_t> by_id(n, -1);
+  bool dense = true;
+  for (std::size_t k = 0; k < n && dense; ++k) {
+    const std::int64_t id = particles.id[k];
+    dense = id >= 0 && static_cast<std::size_t>(id) < n && by_id[static_cast<std::size_t>(id)] < 0;
+    if (dense) by_id[static_cast<std::size_t>(id)] = static_cast<std::int32_t>(k);
+  }
+  if (!dense) {
+    for (std::size_t k = 0; k < n; ++k) by_id[k] = static_cast<std::int32_t>(k);
+    std::sort(by_id.begin(), by_id.end(), [&](std::int32_t a, std::int32_t b) { return particles.id[a] < particles.id[b]; });
+  }
+  return by_id;
+}
+
 /// Keep the first n particles.
 template <int D>
 void truncate_particles(Particles<D>& particles, std::size_t n) {

@@ -368,16 +368,18 @@ class Runner {
   void write_snapshot() {
     if (!config_.output.snapshots) return;
     flush_history();
+    const std::vector<std::int32_t> order = sim_.output_order();  // id order (sorted runs)
     if (config_.output.grid_snapshots)
     {
       const NodeField<D> nodes = sim_.grid_totals();
       std::vector<Vec3> normals;
       if (sim_.contact()) sim_.contact()->node_normals(normals);
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), &sim_.grid(), &nodes,
-                       sim_.contact() ? &normals : nullptr, sim_.id_order());
+                       sim_.contact() ? &normals : nullptr, order.empty() ? nullptr : &order);
     }
     else
-      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), nullptr, nullptr, nullptr, sim_.id_order());
+      snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), nullptr, nullptr, nullptr,
+                       order.empty() ? nullptr : &order);
     // The regions of the last step (none before the first step).
     if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
@@ -430,8 +432,9 @@ class Runner {
     std::string saved;
     try {
       SnapshotWriter<D> failure(dir_, "failure", meta_, comm_);
+      const std::vector<std::int32_t> order = sim_.output_order();
       failure.write(sim_.particles(), sim_.time() + dt, sim_.step_count() + 1, nullptr, nullptr, nullptr,
-                    sim_.id_order());
+                    order.empty() ? nullptr : &order);
       saved = "; the failed state is in " + (dir_ / "failure.xdmf").string();
     } catch (const std::exception&) {
       saved = "; the failed state could not be written";

@@ -313,43 +313,41 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
   if (!config_.simulation.sort_particles || distributed() || wls_ || n < sort_min_particles ||
       particles_.id.size() != n)
     return;
-  TransferCache<D> fresh;  // the setup's colouring: blocks of the preferred width (no stencils yet)
-  const TransferCache<D>* coloured = &cache_;
   if (setup) {
-    fresh.n = fresh.n_owned = n;
-    fresh.block_of.assign(n, 0);
-    fresh.order.assign(n, 0);
-    fresh.id_order = cache_.id_order;
-    colour_blocks(grid_, particles_, fresh);
-    coloured = &fresh;
+    // No stencils yet: colour blocks of the preferred width (reach 0) in the cache's colouring
+    // arrays (given back below).
+    cache_.n = cache_.n_owned = n;
+    cache_.block_of.assign(n, 0);
+    cache_.order.assign(n, 0);
+    cache_.reach_lo.setZero();
+    cache_.reach_hi.setZero();
+    cache_.colouring_valid = false;
+    colour_blocks(grid_, particles_, cache_);
+    cache_.colouring_valid = false;  // the stencils' reach may ask for wider blocks
   } else if (!cache_.colouring_valid || cache_.order.size() != n) {
     return;
   }
   // Runs of consecutive storage indices in the colouring's order: sorted, a block is one run
   // (and a particle that changed block since splits one).
-  const std::vector<std::int32_t>& order = coloured->order;
+  const std::vector<std::int32_t>& order = cache_.order;
   std::size_t breaks = 0;
   for (std::size_t k = 1; k < n; ++k) breaks += static_cast<std::size_t>(order[k] != order[k - 1] + 1);
-  if (breaks * sort_run < n) return;
-  permute_particles(particles_, order);  // the particle stored at k was at order[k]
-  tractions_.renumber(order);
-  // The storage indices in id order: ids are 0 .. n-1 in a serial run (any other numbering sorts).
-  std::vector<std::int32_t>& by_id = cache_.id_order;
-  by_id.assign(n, -1);
-  bool dense = true;
-  for (std::size_t k = 0; k < n && dense; ++k) {
-    const std::int64_t id = particles_.id[k];
-    dense = id >= 0 && static_cast<std::size_t>(id) < n && by_id[static_cast<std::size_t>(id)] < 0;
-    if (dense) by_id[static_cast<std::size_t>(id)] = static_cast<std::int32_t>(k);
+  if (breaks * sort_run >= n) {
+    permute_particles(particles_, order);  // the particle stored at k was at order[k]
+    tractions_.renumber(order);
+    cache_.sorted_storage = true;    // the colouring sorts each block by id (transfer/colouring.cpp)
+    cache_.colouring_valid = false;  // block_of and order index the old storage
+    compute_field_offsets();
+    ++particle_sorts_;
   }
-  if (!dense) {
-    std::iota(by_id.begin(), by_id.end(), 0);
-    std::sort(by_id.begin(), by_id.end(), [&](std::int32_t a, std::int32_t b) { return particles_.id[a] < particles_.id[b]; });
+  if (setup) {
+    // Give the set-up colouring back: allocated now, between the set-up's other arrays, it left
+    // the heap laid out so that the first step's stencil arrays raised the peak by about 4 bytes
+    // per particle (bench/memory_per_particle.py); the first build allocates them as it would.
+    std::vector<std::int32_t>().swap(cache_.block_of);
+    std::vector<std::int32_t>().swap(cache_.order);
+    cache_.n = cache_.n_owned = 0;
   }
-  cache_.id_order_kept = true;
-  cache_.colouring_valid = false;  // block_of and order index the old storage
-  compute_field_offsets();
-  ++particle_sorts_;
 }
 
 template <int D>
@@ -359,6 +357,9 @@ std::int64_t Simulation<D>::total_particles() const {
 
 template <int D>
 void Simulation<D>::set_particles(Particles<D> particles) {
+  // Set-up particles that were sorted (keep_particles_sorted): where each was, by id, for the
+  // tractions' faces, which go back to id order (the storage order of `particles` below).
+  const std::vector<std::int32_t> old_by_id = output_order();
   particles_ = std::move(particles);
   if (distributed()) {
     distribution_.partition(particles_);
@@ -370,12 +371,9 @@ void Simulation<D>::set_particles(Particles<D> particles) {
                      [&](std::int32_t a, std::int32_t b) { return particles_.id[a] < particles_.id[b]; });
     reorder_particles(particles_, order);
   }
-  if (!distributed() && !cache_.id_order.empty()) {
-    // The set-up particles were sorted (keep_particles_sorted): the tractions' faces go back to
-    // id order, the storage order of `particles` now, which is then sorted like the set-up's.
-    if (cache_.id_order.size() == particles_.n()) tractions_.renumber(cache_.id_order);
-    cache_.id_order.clear();
-    cache_.id_order_kept = false;
+  if (!old_by_id.empty()) {
+    if (old_by_id.size() == particles_.n()) tractions_.renumber(old_by_id);
+    cache_.sorted_storage = false;
     cache_.colouring_valid = false;
   }
   keep_particles_sorted(true);
@@ -531,7 +529,7 @@ void Simulation<D>::step(double dt) {
     step_stages(dt, need, fmpm_velocities, k, lap);
   } catch (const SimulationFailure& f) {
     distribution_.drop_ghosts(particles_);
-    if (distributed() || cache_.id_order.empty()) throw;  // (distributed: named by collectively)
+    if (distributed() || !cache_.sorted_storage) throw;  // (distributed: named by collectively)
     throw named_by_id(f);  // a sorted serial run
   } catch (...) {
     distribution_.drop_ghosts(particles_);  // a failed step leaves the owned particles only

@@ -159,10 +159,11 @@ class Simulation {
   /// They are sorted again when the colouring's block order falls apart into runs of
   /// consecutive particles shorter than this on average.
   static constexpr std::size_t sort_run = 32;
-  /// Storage indices of the particles in id order, or null when storage order is id order
-  /// (output writes particles in this order, so files list them as a serial run always has).
-  [[nodiscard]] const std::vector<std::int32_t>* id_order() const {
-    return distributed() || cache_.id_order.empty() ? nullptr : &cache_.id_order;
+  /// Storage indices of the particles in id order, or empty when storage order is id order or
+  /// the run is distributed (output writes particles in this order, so that files list them as a
+  /// serial run in creation order does). Computed on each call (4 bytes per particle).
+  [[nodiscard]] std::vector<std::int32_t> output_order() const {
+    return distributed() || !cache_.sorted_storage ? std::vector<std::int32_t>{} : storage_in_id_order(particles_);
   }
   /// How often this run sorted its particles (the setup's sort included).
   [[nodiscard]] long long particle_sorts() const { return particle_sorts_; }

@@ -32,14 +32,13 @@ struct TransferCache {
   /// ranks' particles follow them and are only scattered (docs/parallel.md). n_owned = n unless
   /// the simulation says otherwise after the build.
   std::size_t n_owned = 0;
-  /// Every particle in increasing id (the order of a serial run that never reorders), for the
-  /// colouring's sort and contact's point clouds: a distributed run's owned and ghost particles,
-  /// or a serial run's particles kept in cell-block order (Simulation::sort_particles). Empty:
-  /// storage order is id order.
+  /// A distributed run: every particle in increasing id (the serial order), for the colouring's
+  /// sort and contact's point clouds. Empty: storage order is id order, or sorted_storage.
   std::vector<std::int32_t> id_order;
-  /// id_order stays valid from step to step (a serial run's sorted particles; it changes only
-  /// with the storage order, which clears colouring_valid), so the colouring may keep its sort.
-  bool id_order_kept = false;
+  /// A serial run keeps its particles in cell-block order (Simulation::keep_particles_sorted):
+  /// storage order is not id order, and the colouring sorts each block's particles by id itself
+  /// (no id_order: it would cost 4 bytes per particle for good).
+  bool sorted_storage = false;
 
   // ---- list layout ----
   int stride = 0;                    ///< stencil slots per particle (the family's maximum)

@@ -52,8 +52,7 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
 
   // The sort below depends only on block_of (and the id order), so when no particle changed
   // block since the last colouring with the same blocks, the last result stands.
-  const bool same_blocks = cache.colouring_valid && (cache.id_order.empty() || cache.id_order_kept) &&
-                           cache.colouring_blocks == n_blocks &&
+  const bool same_blocks = cache.colouring_valid && cache.id_order.empty() && cache.colouring_blocks == n_blocks &&
                            cache.colouring_colours == n_colours;
   int changed = same_blocks ? 0 : 1;
 #pragma omp parallel reduction(| : changed) if (n >= particle_loop_min)
@@ -89,6 +88,31 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
       cache.order[cache.cursor[cache.block_of[p]]++] = static_cast<std::int32_t>(p);
   } else {
     for (const std::int32_t p : cache.id_order) cache.order[cache.cursor[cache.block_of[p]]++] = p;
+  }
+  if (cache.sorted_storage) {
+    // Particles kept in block order, by id within a block (Simulation::keep_particles_sorted):
+    // a block's list, taken in storage order, is a few runs of increasing id, its own particles
+    // and those that entered it from each neighbouring block since the last sort. Merging the
+    // runs puts it in id order (nothing to do for a block nobody entered).
+    const auto by_id = [&](std::int32_t a, std::int32_t b) { return particles.id[a] < particles.id[b]; };
+    std::vector<std::int32_t> runs;
+    for (int b = 0; b < total_blocks; ++b) {
+      std::int32_t* first = cache.order.data() + cache.block_begin[b];
+      const std::int32_t m = cache.block_begin[b + 1] - cache.block_begin[b];
+      runs.assign(1, 0);
+      for (std::int32_t k = 1; k < m; ++k)
+        if (by_id(first[k], first[k - 1])) runs.push_back(k);
+      runs.push_back(m);
+      while (runs.size() > 2) {
+        std::size_t kept = 1;
+        for (std::size_t r = 0; r + 2 < runs.size(); r += 2) {
+          std::inplace_merge(first + runs[r], first + runs[r + 1], first + runs[r + 2], by_id);
+          runs[kept++] = runs[r + 2];
+        }
+        if (runs.size() % 2 == 0) runs[kept++] = runs.back();  // an odd run count: the last one waits
+        runs.resize(kept);
+      }
+    }
   }
 
   cache.colour_blocks.resize(total_colours);
