@@ -5,7 +5,6 @@
 // traction; a failure names the particle by id; output lists particles in id order; a restart
 // continues bit-identically.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/fresh_dir.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/hdf5_util.hpp"
 #include "cairn/io/input.hpp"
@@ -72,12 +72,6 @@ friction = 0.2
 snapshots = false
 checkpoints = false
 )toml";
-
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("cairn_test_order_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d;
-}
 
 /// Particle state keyed by id.
 struct State {
@@ -211,7 +205,7 @@ TEST(ParticleOrder, OutputListsParticlesInIdOrderAndRestartsAreBitIdentical) {
   fs::path dir[2];
   RunSummary summary[2];
   for (const bool sort : {false, true}) {
-    dir[sort] = fresh_dir(sort ? "sorted" : "unsorted");
+    dir[sort] = test::fresh_dir(sort ? "order_sorted" : "order_unsorted");
     std::vector<std::string> sets = common;
     sets.push_back(std::string("simulation.sort_particles=") + (sort ? "true" : "false"));
     sets.push_back("output.directory=\"" + dir[sort].string() + "\"");
@@ -231,7 +225,7 @@ TEST(ParticleOrder, OutputListsParticlesInIdOrderAndRestartsAreBitIdentical) {
     for (const char* name : {"body", "material"})
       EXPECT_EQ(h5::read_ints_rows(ga.get(), name, 0, n), h5::read_ints_rows(gb.get(), name, 0, n)) << file << " " << name;
   }
-  const fs::path again = fresh_dir("restarted");
+  const fs::path again = test::fresh_dir("order_restarted");
   const RunSummary rest = restart(dir[1] / "checkpoint-0000.h5", {"output.directory=\"" + again.string() + "\""}, quiet);
   EXPECT_GT(rest.steps, 0);
   expect_same(by_id(read_checkpoint<2>(summary[1].last_checkpoint).particles),

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/fresh_dir.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/sim/run.hpp"
@@ -47,11 +48,7 @@ every = 5.0e-5
 checkpoint_every = 1.0e-4
 )toml";
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("cairn_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d;
-}
+using test::fresh_dir;
 
 TEST(RunLoop, TimeStepNoteForFmpmAboveItsCriticalCfl) {
   // FMPM(k) lowers the critical time step by up to sqrt(k) (docs/update-schemes.md): a note when

@@ -260,9 +260,9 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     cloud_begin_.assign(nc + 1, 0);
     // Particles in increasing id (a distributed run's ghosts included; a serial run's particles
     // kept in cell-block order), as in a serial run in creation order.
-    const std::vector<std::int32_t> sorted_ids =
-        cache.sorted_storage && cache.id_order.empty() ? storage_in_id_order(particles) : std::vector<std::int32_t>{};
-    const std::vector<std::int32_t>& ids = cache.id_order.empty() ? sorted_ids : cache.id_order;
+    const bool own_order = cache.sorted_storage && cache.id_order.empty();
+    if (own_order) storage_in_id_order(particles, id_order_);
+    const std::vector<std::int32_t>& ids = own_order ? id_order_ : cache.id_order;
     auto particle_at = [&](std::int64_t k) { return ids.empty() ? k : std::int64_t{ids[static_cast<std::size_t>(k)]}; };
     for (std::int64_t p = 0; p < np; ++p)
       for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {

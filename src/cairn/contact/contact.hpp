@@ -119,6 +119,7 @@ class Contact {
   std::vector<std::int32_t> fields_;
   std::vector<std::int32_t> cloud_begin_;  ///< CSR: particles whose stencil holds contact node c
   std::vector<std::int32_t> cloud_;
+  std::vector<std::int32_t> id_order_;    ///< sorted serial runs: particles in id order (scratch)
   std::vector<double> cloud_weight_;       ///< S_ip of each cloud entry (lr_weights = "shape")
   std::vector<std::int32_t> inter_begin_;  ///< CSR: interactions of contact node c
   std::vector<Interaction> inter_;

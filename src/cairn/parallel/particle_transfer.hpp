@@ -114,12 +114,12 @@ void permute_particles(Particles<D>& particles, const std::vector<std::int32_t>&
   });
 }
 
-/// Storage indices of the particles in increasing id (ids 0 .. n-1, a serial run's, are placed
-/// directly; any other numbering is sorted).
+/// Storage indices of the particles in increasing id, into `by_id` (its capacity reused; ids
+/// 0 .. n-1, a serial run's, are placed directly; any other numbering is sorted).
 template <int D>
-std::vector<std::int32_t> storage_in_id_order(const Particles<D>& particles) {
+void storage_in_id_order(const Particles<D>& particles, std::vector<std::int32_t>& by_id) {
   const std::size_t n = particles.n();
-  std::vector<std::int32_t> by_id(n, -1);
+  by_id.assign(n, -1);
   bool dense = true;
   for (std::size_t k = 0; k < n && dense; ++k) {
     const std::int64_t id = particles.id[k];
@@ -130,7 +130,6 @@ std::vector<std::int32_t> storage_in_id_order(const Particles<D>& particles) {
     for (std::size_t k = 0; k < n; ++k) by_id[k] = static_cast<std::int32_t>(k);
     std::sort(by_id.begin(), by_id.end(), [&](std::int32_t a, std::int32_t b) { return particles.id[a] < particles.id[b]; });
   }
-  return by_id;
 }
 
 /// Keep the first n particles.

@@ -163,7 +163,9 @@ class Simulation {
   /// the run is distributed (output writes particles in this order, so that files list them as a
   /// serial run in creation order does). Computed on each call (4 bytes per particle).
   [[nodiscard]] std::vector<std::int32_t> output_order() const {
-    return distributed() || !cache_.sorted_storage ? std::vector<std::int32_t>{} : storage_in_id_order(particles_);
+    std::vector<std::int32_t> order;
+    if (!distributed() && cache_.sorted_storage) storage_in_id_order(particles_, order);
+    return order;
   }
   /// How often this run sorted its particles (the setup's sort included).
   [[nodiscard]] long long particle_sorts() const { return particle_sorts_; }

@@ -95,7 +95,7 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     // and those that entered it from each neighbouring block since the last sort. Merging the
     // runs puts it in id order (nothing to do for a block nobody entered).
     const auto by_id = [&](std::int32_t a, std::int32_t b) { return particles.id[a] < particles.id[b]; };
-    std::vector<std::int32_t> runs;
+    std::vector<std::int32_t>& runs = cache.id_runs;
     for (int b = 0; b < total_blocks; ++b) {
       std::int32_t* first = cache.order.data() + cache.block_begin[b];
       const std::int32_t m = cache.block_begin[b + 1] - cache.block_begin[b];
