@@ -5,9 +5,14 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
+#include <numeric>
+#include <random>
+
 #include "../support/config_builder.hpp"
 #include "cairn/sim/names.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/transfer/transfer.hpp"
 #include "cairn/util/parallel.hpp"
 
 namespace cairn {
@@ -39,6 +44,50 @@ TEST(ShapeFamiliesInParallel, EveryFamilyIsBitIdenticalForAnyThreadCount) {
         ASSERT_EQ(results[r].velocity[p], results[0].velocity[p]) << name;
         ASSERT_EQ(results[r].kirchhoff_stress[p], results[0].kirchhoff_stress[p]) << name;
       }
+  }
+  omp_set_num_threads(omp_get_num_procs());
+}
+
+// The colouring's binning and counting sort run in one team from particle_loop_min particles:
+// for 1, 2 and 3 threads they give the serial stable sort by block (storage order within a
+// block, or a distributed run's id order), the same block offsets and the same colour lists.
+TEST(ParticleAffinity, ColouringSortIsTheStableSortForAnyThreadCount) {
+  const Grid<2> grid(Vec<2>(0.0, 0.0), IVec<2>(64, 48), Vec<2>(1.0, 1.0), 2, {false, false});
+  Particles<2> particles;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(0.0, 64.0), y(0.0, 48.0);
+  const std::size_t n = 3 * particle_loop_min + 5;
+  particles.resize(n);
+  for (std::size_t p = 0; p < n; ++p) particles.position[p] = Vec<2>(x(rng), y(rng));
+  for (const bool by_id : {false, true}) {
+    std::vector<std::int32_t> sequence(n);
+    std::iota(sequence.begin(), sequence.end(), 0);
+    if (by_id) std::shuffle(sequence.begin(), sequence.end(), rng);  // a distributed run's id order
+    std::vector<TransferCache<2>> caches;
+    for (const int threads : {1, 2, 3}) {
+      omp_set_num_threads(threads);
+      TransferCache<2>& cache = caches.emplace_back();
+      cache.reserve(n, 4);
+      if (by_id) cache.id_order = sequence;
+      colour_blocks(grid, particles, cache);
+    }
+    // The reference: the block of every particle, then a serial stable sort of the sequence.
+    const TransferCache<2>& first = caches.front();
+    std::vector<std::int32_t> block(n);
+    for (int b = 0; b + 1 < static_cast<int>(first.block_begin.size()); ++b)
+      for (std::int32_t i = first.block_begin[b]; i < first.block_begin[b + 1]; ++i) block[first.order[i]] = b;
+    std::vector<std::int32_t> expected = sequence;
+    std::stable_sort(expected.begin(), expected.end(), [&](std::int32_t a, std::int32_t b) { return block[a] < block[b]; });
+    ASSERT_GT(first.block_begin.size(), 10U);  // several blocks
+    for (const auto& cache : caches) {
+      ASSERT_EQ(cache.order, expected) << "by id " << by_id;
+      ASSERT_EQ(cache.block_begin, first.block_begin);
+      ASSERT_EQ(cache.colour_blocks, first.colour_blocks);
+      for (std::size_t p = 0; p < n; ++p)  // each particle in the block of its cell
+        ASSERT_EQ(block[p], (static_cast<int>(particles.position[p][0]) / 8) +
+                                (static_cast<int>(particles.position[p][1]) / 8) * 8)
+            << p;
+    }
   }
   omp_set_num_threads(omp_get_num_procs());
 }

@@ -181,7 +181,9 @@ TEST(ParticleOrder, AFailureNamesTheParticleById) {
                                            "contact.mode=\"none\""});
     Simulation<2> sim(cfg);
     const std::int64_t last = static_cast<std::int64_t>(sim.particles().n()) - 1;
-    if (sort) EXPECT_EQ(sim.particles().id[0], last);
+    if (sort) {
+      EXPECT_EQ(sim.particles().id[0], last);
+    }
     try {
       for (int s = 0; s < 200; ++s) sim.step(sim.next_dt());
       FAIL() << "the flyer should leave the grid";

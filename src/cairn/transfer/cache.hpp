@@ -69,7 +69,7 @@ struct TransferCache {
   /// of T the blocks of the t-th T-quantile (transfer/transfer.hpp, scatter).
   std::vector<std::vector<std::int64_t>> colour_rank;
   std::vector<std::int32_t> block_of;       ///< scratch: block of each particle
-  std::vector<std::int32_t> cursor;         ///< scratch for the counting sort
+  std::vector<std::int32_t> cursor;         ///< scratch: per-thread block counts of the sort
   std::vector<std::int32_t> by_middle;      ///< scratch: a colour's blocks ranked by middle particle
   std::vector<std::int32_t> id_runs;        ///< scratch: bounds of a block's runs of increasing id
   /// order/block_begin/colour_blocks are the sort of block_of for these block and colour counts

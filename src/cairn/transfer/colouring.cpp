@@ -54,11 +54,18 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
   // block since the last colouring with the same blocks, the last result stands.
   const bool same_blocks = cache.colouring_valid && cache.id_order.empty() && cache.colouring_blocks == n_blocks &&
                            cache.colouring_colours == n_colours;
+  // Binning and a stable counting sort in one team (util/parallel.hpp, particle affinity): each
+  // thread bins the particles it built, counts its share of the sort's sequence (storage order,
+  // or a distributed run's id order) per block, and places them after the earlier threads'
+  // shares of each block. The result is the serial sort's for any thread count.
+  const bool in_id_order = !cache.id_order.empty();
+  const auto n_seq = in_id_order ? static_cast<std::int64_t>(cache.id_order.size()) : n;
   int changed = same_blocks ? 0 : 1;
-#pragma omp parallel reduction(| : changed) if (n >= particle_loop_min)
+#pragma omp parallel if (n >= particle_loop_min)
   {
-    // Each thread bins the particles it built (util/parallel.hpp, particle affinity).
-    const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    const int t = omp_get_thread_num(), T = omp_get_num_threads();
+    const auto [first, last] = static_range(n, t, T);
+    int changed_t = 0;
     for (std::int64_t p = first; p < last; ++p) {
       const IVec<D> cell = grid.cell_of(particles.position[p]);  // as the families' reach
       int id = 0, mult = 1;
@@ -67,8 +74,48 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
         id += (c >= -margin && c < n_cells[a] + margin ? table[a][c + margin] : block_along(a, c)) * mult;
         mult *= n_blocks[a];
       }
-      changed |= static_cast<int>(cache.block_of[p] != id);
+      changed_t |= static_cast<int>(cache.block_of[p] != id);
       cache.block_of[p] = id;
+    }
+    if (changed_t) {
+#pragma omp atomic write
+      changed = 1;
+    }
+#pragma omp barrier
+    int any_changed;
+#pragma omp atomic read
+    any_changed = changed;
+    if (any_changed) {  // the same for every thread
+      const auto [first_k, last_k] = in_id_order ? static_range(n_seq, t, T) : std::pair{first, last};
+      const auto particle_at = [&](std::int64_t k) { return in_id_order ? cache.id_order[k] : static_cast<std::int32_t>(k); };
+      // Each thread's counts in a row of whole cache lines (no line written by two cores).
+      const std::size_t row = (static_cast<std::size_t>(total_blocks) + 15) / 16 * 16;
+#pragma omp single
+      cache.cursor.assign(T * row, 0);
+      std::int32_t* cursor = cache.cursor.data() + t * row;
+      for (std::int64_t k = first_k; k < last_k; ++k) ++cursor[cache.block_of[particle_at(k)]];
+#pragma omp barrier
+#pragma omp single
+      {
+        // Block b's particles: thread 0's share, then thread 1's, ... (cursor becomes each
+        // thread's first place in the block).
+        cache.block_begin.resize(total_blocks + 1);
+        std::int32_t at = 0;
+        for (int b = 0; b < total_blocks; ++b) {
+          cache.block_begin[b] = at;
+          for (int u = 0; u < T; ++u) {
+            std::int32_t& c = cache.cursor[u * row + b];
+            const std::int32_t count = c;
+            c = at;
+            at += count;
+          }
+        }
+        cache.block_begin[total_blocks] = at;
+      }
+      for (std::int64_t k = first_k; k < last_k; ++k) {
+        const std::int32_t p = particle_at(k);
+        cache.order[cursor[cache.block_of[p]]++] = p;
+      }
     }
   }
   if (!changed) return;
@@ -76,19 +123,8 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
   cache.colouring_blocks = n_blocks;
   cache.colouring_colours = n_colours;
 
-  // Stable counting sort of particles by block.
-  cache.block_begin.assign(total_blocks + 1, 0);
-  for (std::int64_t p = 0; p < n; ++p) ++cache.block_begin[cache.block_of[p] + 1];
-  for (int b = 0; b < total_blocks; ++b) cache.block_begin[b + 1] += cache.block_begin[b];
-  cache.cursor.assign(cache.block_begin.begin(), cache.block_begin.end() - 1);
   // Within a block, particles in increasing id (storage order, or the id order of a distributed
   // run's owned and ghost particles), so that every node adds them in the serial order.
-  if (cache.id_order.empty()) {
-    for (std::int64_t p = 0; p < n; ++p)
-      cache.order[cache.cursor[cache.block_of[p]]++] = static_cast<std::int32_t>(p);
-  } else {
-    for (const std::int32_t p : cache.id_order) cache.order[cache.cursor[cache.block_of[p]]++] = p;
-  }
   if (cache.sorted_storage) {
     // Particles kept in block order, by id within a block (Simulation::keep_particles_sorted):
     // a block's list, taken in storage order, is a few runs of increasing id, its own particles

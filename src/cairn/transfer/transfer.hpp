@@ -376,10 +376,11 @@ ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
   return total;
 }
 
-/// Parallel loop over nodes (on the calling thread for small grids, util/parallel.hpp).
+/// Parallel loop over nodes (on the calling thread for small grids, util/parallel.hpp,
+/// node_loop_min).
 template <class Fn>
 void for_each_node(std::int32_t n_nodes, Fn&& fn) {
-#pragma omp parallel for schedule(static) if (n_nodes >= parallel_min_items)
+#pragma omp parallel for schedule(static) if (n_nodes >= node_loop_min)
   for (std::int32_t i = 0; i < n_nodes; ++i) fn(i);
 }
 

@@ -7,12 +7,19 @@
 
 namespace cairn {
 
-/// Loops of simple per-item work (node loops, per-particle bookkeeping) shorter than this run on
+/// Loops of simple per-item work (grid conditions, per-particle bookkeeping) shorter than this run on
 /// the calling thread: handing a few microseconds of work to a team costs more than it saves,
 /// above all on a shared machine where a sleeping thread takes tens of microseconds to wake
 /// (docs/performance.md, "Threads on a shared machine"). Such loops have no order-dependent
 /// sums, so the results are the same either way.
 inline constexpr std::int64_t parallel_min_items = 32768;
+
+/// Loops over every node of the grid (transfer.hpp, for_each_node) run in parallel from this many
+/// nodes. They sit between particle loops whose team is still spinning, so the region costs
+/// about a microsecond, and a serial node loop of a few thousand nodes kept the other thread
+/// idle for 10-20 us of every step (problem (a) of issue 13: 2 threads 1.02x faster with 4096
+/// than with parallel_min_items; docs/performance.md, "Threads").
+inline constexpr std::int64_t node_loop_min = 4096;
 
 /// Particle affinity. Every particle stage of a step (stencil build, gathers, scatters) gives a
 /// particle to the same thread while the particles are few enough for their data to stay in the
