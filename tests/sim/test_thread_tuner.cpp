@@ -32,6 +32,24 @@ TEST(ThreadTuner, SettlesOnOneThreadWhenTheTeamIsSlower) {
   omp_set_num_threads(saved);
 }
 
+TEST(ThreadTuner, AProbeOfTheTeamEndsAfterItsFirstStepWhenThatIsAlreadySlower) {
+  // Busy machine: the team's first step of a probe is slower than one thread's, so the probe
+  // takes one step instead of warm + timed. Team steps in 1000: the first hold (3), then one per
+  // probe after holds of 16 and 256 steps.
+  ThreadTuner tuner(2, true);
+  const long long single = drive(tuner, 1000, 2e-3, 1e-3);
+  EXPECT_EQ(tuner.threads(), 1);
+  EXPECT_EQ(1000 - single, ThreadTuner::warm_steps + ThreadTuner::timed_steps + 2);
+}
+
+TEST(ThreadTuner, GoesBackToTheTeamWhenTheMachineIsIdleAgain) {
+  ThreadTuner tuner(2, true);
+  drive(tuner, 1100, 3e-3, 1e-3);  // busy: one thread
+  ASSERT_EQ(tuner.threads(), 1);
+  drive(tuner, 1100, 0.5e-3, 1e-3);  // idle again: the next probe's first step is faster
+  EXPECT_EQ(tuner.threads(), 2);
+}
+
 TEST(ThreadTuner, KeepsTheTeamWhenItIsFasterAndProbesLessOften) {
   // A close race (one thread 1.11x slower, within ThreadTuner::sure_margin): the hold grows 4x.
   ThreadTuner tuner(2, true);

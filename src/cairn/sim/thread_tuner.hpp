@@ -5,7 +5,8 @@
 // waiting for a member that lost its core; on an idle machine it runs nearly twice as fast on
 // two cores. Neither can be known before the run, and the load changes during it, so the run
 // loop times its steps: it holds the current choice for a while, then runs a short probe with
-// the other count and keeps whichever was faster per step. The hold grows while the choice
+// the other count and keeps whichever was faster per step (a probe of the full team ends after
+// its first step when that is already slower than one thread). The hold grows while the choice
 // stays the same (the probes cost less and less of the run) and shrinks again when it changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
 // changes nothing but the speed.
@@ -56,6 +57,13 @@ class ThreadTuner {
     ++steps_;
     if (current_ == 1) ++single_steps_;
     ++in_phase_;
+    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > chosen_time_) {
+      // The full team's first step, which also wakes the parked threads, is already slower than
+      // the choice: a busy machine. The probe ends here; its timed steps would cost the most
+      // exactly then (docs/performance.md, "Threads").
+      end_probe(seconds);
+      return;
+    }
     const long long length = probing_ ? probe_length() : hold_;
     if (in_phase_ > length - timed_steps) timed_ += seconds;
     if (in_phase_ < length) return;
@@ -73,6 +81,19 @@ class ThreadTuner {
       probing_ = true;
       return;
     }
+    end_probe(per_step);
+  }
+
+  /// Gives OpenMP back the full team (for what runs after the loop).
+  void finish() const {
+    if (enabled_) omp_set_num_threads(max_);
+  }
+
+ private:
+  /// Ends the probe now running, whose steps took per_step each: keeps the faster count.
+  void end_probe(double per_step) {
+    in_phase_ = 0;
+    timed_ = 0.0;
     probing_ = false;
     if (per_step < chosen_time_) {
       chosen_ = current_;
@@ -84,12 +105,6 @@ class ThreadTuner {
     current_ = chosen_;
   }
 
-  /// Gives OpenMP back the full team (for what runs after the loop).
-  void finish() const {
-    if (enabled_) omp_set_num_threads(max_);
-  }
-
- private:
   /// Steps of the probe now running (current_ is the probed count).
   [[nodiscard]] long long probe_length() const { return current_ == 1 ? timed_steps : warm_steps + timed_steps; }
 
