@@ -1,188 +1,73 @@
-// Gmsh API access: reading .msh files and meshing the generated shapes. Gmsh keeps one global
-// model, so every use is serialised by a mutex and wrapped in initialize/finalize.
-#include <gmsh.h>
+// Gmsh meshes through the mesher module (fem/gmsh_module.hpp), loaded at first use.
+#include <dlfcn.h>
 
-#include <fmt/format.h>
-
-#include <cmath>
 #include <filesystem>
-#include <mutex>
-#include <numbers>
 #include <stdexcept>
-#include <unordered_map>
+#include <utility>
 
+#include "cairn/fem/gmsh_module.hpp"
 #include "cairn/fem/mesh.hpp"
 #include "cairn/io/errors.hpp"
 
 namespace cairn::fem {
 namespace {
 
-std::mutex& gmsh_mutex() {
-  static std::mutex m;
-  return m;
-}
-
-/// One Gmsh session: initialised quietly, finalised on scope exit.
-class GmshSession {
- public:
-  GmshSession() : lock_(gmsh_mutex()) {
-    gmsh::initialize(0, nullptr, false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.Verbosity", 0);
-  }
-  ~GmshSession() { gmsh::finalize(); }
-  GmshSession(const GmshSession&) = delete;
-  GmshSession& operator=(const GmshSession&) = delete;
-
- private:
-  std::lock_guard<std::mutex> lock_;
-};
-
-/// Text of whatever Gmsh threw (Gmsh 4.8 throws std::string; later versions std::exception).
-std::string current_error() {
-  try {
-    throw;
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (const std::string& s) {
-    return s;
-  } catch (const char* s) {
-    return s;
-  } catch (...) {
-    return "unknown Gmsh error";
-  }
-}
-
-/// The 3-node triangles of the current Gmsh model. `key` and `source` for messages.
-TriangleMesh extract(const std::string& source, const std::string& key) {
-  const auto bad = [&](const std::string& expected, const std::string& found) {
-    throw InputError(source, 0, key, expected, found);
-  };
-  std::vector<std::size_t> node_tags;
-  std::vector<double> coords, param;
-  gmsh::model::mesh::getNodes(node_tags, coords, param, -1, -1, false, false);
-  std::unordered_map<std::size_t, std::size_t> index_of_tag;
-  for (std::size_t i = 0; i < node_tags.size(); ++i) {
-    index_of_tag[node_tags[i]] = i;
-    if (std::abs(coords[3 * i + 2]) > 0.0)
-      bad("a planar mesh in z = 0", fmt::format("node {} at z = {}", node_tags[i], coords[3 * i + 2]));
-  }
-  std::vector<int> types;
-  std::vector<std::vector<std::size_t>> element_tags, element_nodes;
-  gmsh::model::mesh::getElements(types, element_tags, element_nodes, -1, -1);
-  TriangleMesh m;
-  m.source = source;
-  std::unordered_map<std::size_t, std::int32_t> compact;  // Gmsh node tag -> mesh node
-  for (std::size_t k = 0; k < types.size(); ++k) {
-    std::string name;
-    int dim = 0, order = 0, n_nodes = 0, n_primary = 0;
-    std::vector<double> local;
-    gmsh::model::mesh::getElementProperties(types[k], name, dim, order, n_nodes, local, n_primary);
-    if (dim < 2) continue;  // points and lines: boundary entities
-    if (types[k] != 2)
-      bad("3-node triangles only (Gmsh element type 2)",
-          fmt::format("element {} of type {} ({}), one of {} such elements", element_tags[k].front(), types[k], name,
-                      element_tags[k].size()));
-    for (std::size_t e = 0; e < element_tags[k].size(); ++e) {
-      std::array<std::int32_t, 3> t{};
-      for (int c = 0; c < 3; ++c) {
-        const std::size_t tag = element_nodes[k][3 * e + static_cast<std::size_t>(c)];
-        const auto it = index_of_tag.find(tag);
-        if (it == index_of_tag.end())
-          bad("elements whose nodes exist", fmt::format("element {} refers to missing node {}", element_tags[k][e], tag));
-        auto [slot, added] = compact.try_emplace(tag, static_cast<std::int32_t>(m.nodes.size()));
-        if (added) m.nodes.emplace_back(coords[3 * it->second], coords[3 * it->second + 1]);
-        t[static_cast<std::size_t>(c)] = slot->second;
+/// Loads libcairn_gmsh.so from beside the running program (build/release/cairn), else from where
+/// the build put it (programs elsewhere: the tests, copies of the binary), once per process.
+const GmshModule& gmsh() {
+  static const GmshModule* const loaded = [] {
+    std::vector<std::string> candidates;
+    std::error_code ec;
+    const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec) candidates.push_back((self.parent_path() / "libcairn_gmsh.so").string());
+    candidates.emplace_back(CAIRN_GMSH_MODULE);
+    std::string why;
+    for (const std::string& path : candidates) {
+      void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (handle == nullptr) {
+        why += std::string("\n  ") + ::dlerror();
+        continue;
       }
-      m.triangles.push_back(t);
-      m.element_tags.push_back(element_tags[k][e]);
+      const auto entry = reinterpret_cast<const GmshModule* (*)()>(::dlsym(handle, "cairn_gmsh_module"));
+      const GmshModule* m = entry != nullptr ? entry() : nullptr;
+      if (m == nullptr || m->version != gmsh_module_version) {
+        why += "\n  " + path + ": not a Cairn Gmsh module of version " + std::to_string(gmsh_module_version);
+        ::dlclose(handle);
+        continue;
+      }
+      return m;  // kept loaded for the life of the process
     }
-  }
-  return m;
+    throw std::runtime_error("the Gmsh mesher module could not be loaded (rebuild Cairn):" + why);
+  }();
+  return *loaded;
+}
+
+/// Turns every clockwise triangle round.
+void orient(TriangleMesh& m) {
+  for (std::size_t e = 0; e < m.triangles.size(); ++e)
+    if (twice_area(m, e) < 0.0) std::swap(m.triangles[e][1], m.triangles[e][2]);
 }
 
 }  // namespace
 
 TriangleMesh read_gmsh_file(const std::string& path) {
-  const std::string key = "fem.mesh_file";
   if (!std::filesystem::is_regular_file(path))
-    throw InputError(path, 0, key, "a readable Gmsh .msh file", "no such file");
-  GmshSession session;
-  try {
-    gmsh::open(path);
-  } catch (...) {
-    throw InputError(path, 0, key, "a Gmsh .msh file Gmsh can read", current_error());
-  }
-  TriangleMesh m = extract(path, key);
+    throw InputError(path, 0, "fem.mesh_file", "a readable Gmsh .msh file", "no such file");
+  TriangleMesh m = gmsh().read_file(path);
   // A surface meshed with its normal along -z has every triangle clockwise: turn them all
   // round. A mesh with some clockwise elements among counter-clockwise ones keeps them, and
   // check_mesh rejects them as inverted.
   bool all_clockwise = !m.triangles.empty();
   for (std::size_t e = 0; e < m.triangles.size() && all_clockwise; ++e) all_clockwise = twice_area(m, e) < 0.0;
-  if (all_clockwise)
-    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+  if (all_clockwise) orient(m);
   return m;
 }
 
 TriangleMesh generate_gmsh(const FemConfig& fem) {
-  const BodyShapeConfig& s = fem.shape;
-  const std::string source = fmt::format("generated {} mesh", s.kind);
-  GmshSession session;
-  try {
-    gmsh::model::add("cairn");
-    namespace occ = gmsh::model::occ;
-    int surface = -1;
-    const auto disk = [](double cx, double cy, double rx, double ry) {
-      if (rx >= ry) return occ::addDisk(cx, cy, 0.0, rx, ry);
-      // OpenCASCADE wants the major radius along x: make it so, then turn by 90 degrees.
-      const int tag = occ::addDisk(cx, cy, 0.0, ry, rx);
-      occ::rotate({{2, tag}}, cx, cy, 0.0, 0.0, 0.0, 1.0, 0.5 * std::numbers::pi);
-      return tag;
-    };
-    const auto cut = [](int object, int tool) {
-      gmsh::vectorpair out;
-      std::vector<gmsh::vectorpair> map;
-      occ::cut({{2, object}}, {{2, tool}}, out, map);
-      if (out.size() != 1) throw std::runtime_error(fmt::format("the cut left {} surfaces", out.size()));
-      return out.front().second;
-    };
-    if (s.kind == "box") {
-      surface = occ::addRectangle(s.min[0], s.min[1], 0.0, s.max[0] - s.min[0], s.max[1] - s.min[1]);
-    } else if (s.kind == "circle") {
-      surface = disk(s.center[0], s.center[1], s.radius, s.radius);
-    } else if (s.kind == "ellipse") {
-      surface = disk(s.center[0], s.center[1], s.semi_axes[0], s.semi_axes[1]);
-    } else if (s.kind == "annulus") {
-      surface = cut(disk(s.center[0], s.center[1], s.outer_radius, s.outer_radius),
-                    disk(s.center[0], s.center[1], s.inner_radius, s.inner_radius));
-    } else if (s.kind == "polygon") {
-      std::vector<int> points, lines;
-      for (const auto& v : s.vertices) points.push_back(occ::addPoint(v[0], v[1], 0.0));
-      for (std::size_t i = 0; i < points.size(); ++i)
-        lines.push_back(occ::addLine(points[i], points[(i + 1) % points.size()]));
-      surface = occ::addPlaneSurface({occ::addCurveLoop(lines)});
-    } else {
-      throw std::runtime_error("no Gmsh generator for shape kind " + s.kind);
-    }
-    if (fem.hole_radius > 0.0)
-      surface = cut(surface, disk(fem.hole_center[0], fem.hole_center[1], fem.hole_radius, fem.hole_radius));
-    occ::synchronize();
-    gmsh::option::setNumber("Mesh.MeshSizeMax", fem.size);
-    gmsh::option::setNumber("Mesh.MeshSizeMin", 0.0);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 1);
-    gmsh::option::setNumber("Mesh.Algorithm", 6);  // Frontal-Delaunay
-    gmsh::model::mesh::generate(2);
-  } catch (const InputError&) {
-    throw;
-  } catch (...) {
-    throw InputError(source, 0, "fem.shape", "a shape Gmsh can mesh", current_error());
-  }
-  TriangleMesh m = extract(source, "fem.shape");
+  TriangleMesh m = gmsh().generate(fem);
   // Gmsh orients the triangles by the surface normal; OpenCASCADE planar faces face +z, but
   // turn any clockwise element round rather than rely on it.
-  for (std::size_t e = 0; e < m.triangles.size(); ++e)
-    if (twice_area(m, e) < 0.0) std::swap(m.triangles[e][1], m.triangles[e][2]);
+  orient(m);
   return m;
 }
 
