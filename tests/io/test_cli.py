@@ -97,6 +97,17 @@ def usage_and_exit_codes(cairn, tmp):
     check("missing.toml" in proc.stderr, "a missing input file is bad input: exit code 2")
 
 
+def gmsh_loaded_on_demand(cairn, tmp):
+    # Gmsh and its 91 libraries live in the module beside the binary (src/cairn/fem/gmsh_module.hpp),
+    # not among the libraries every command loads at start (docs/performance.md, "Start-up").
+    libs = subprocess.run(["ldd", cairn], capture_output=True, text=True, check=True).stdout
+    check("libgmsh" not in libs, "cairn does not load Gmsh at start (ldd)")
+    module = os.path.join(os.path.dirname(cairn), "libcairn_gmsh.so")
+    check(os.path.isfile(module), "the Gmsh mesher module is built beside cairn")
+    check("libgmsh" in subprocess.run(["ldd", module], capture_output=True, text=True, check=True).stdout,
+          "the module links Gmsh")
+
+
 def progress_bar(cairn, tmp):
     case = write_case(os.path.join(tmp, "bar", "case.toml"), end_time=4.0e-6)
     pid, fd = pty.fork()
@@ -226,7 +237,7 @@ def main():
     cairn = os.path.abspath(sys.argv[1])
     with tempfile.TemporaryDirectory(prefix="cairn_cli_") as tmp:
         try:
-            for case in (usage_and_exit_codes, progress_bar, interrupts, wall_clock_checkpoints,
+            for case in (usage_and_exit_codes, gmsh_loaded_on_demand, progress_bar, interrupts, wall_clock_checkpoints,
                          relative_folders_and_restarts, orphan_temporaries):
                 print(case.__name__)
                 case(cairn, tmp)
