@@ -6,8 +6,9 @@
 // two cores. Neither can be known before the run, and the load changes during it, so the run
 // loop times its steps: it holds the current choice for a while, then runs a short probe with
 // the other count and keeps whichever was faster per step (a probe of the full team ends after
-// its first step when that is already slower than one thread). The hold grows while the choice
-// stays the same (the probes cost less and less of the run) and shrinks again when it changes.
+// its first step when that is already clearly slower than one thread). The hold grows while the
+// choice stays the same (the probes cost less and less of the run) and shrinks again when it
+// changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
 // changes nothing but the speed.
 #pragma once
@@ -15,15 +16,17 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 
 namespace cairn {
 
 class ThreadTuner {
  public:
-  /// Steps of a probe of the full team not timed (its first step wakes the parked threads; a
-  /// probe of one thread needs no such step), steps timed at the end of a hold and of a probe,
+  /// Steps of a probe of the full team not timed (its first step moves the particles' data to
+  /// the other cores' caches; before_step has woken the threads, untimed; a probe of one thread
+  /// needs no such step), steps timed at the end of a hold and of a probe (their median counts),
   /// and the hold lengths.
-  static constexpr int warm_steps = 1, timed_steps = 2;
+  static constexpr int warm_steps = 1, timed_steps = 3;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
   /// A probe slower than the choice by more than this factor confirms the choice beyond the
   /// noise of a few steps: the hold then grows by sure_growth instead of hold_growth, so that
@@ -46,9 +49,19 @@ class ThreadTuner {
   [[nodiscard]] long long single_thread_steps() const { return single_steps_; }
   [[nodiscard]] long long steps() const { return steps_; }
 
-  /// Sets OpenMP's thread count for the next step.
-  void before_step() const {
-    if (enabled_) omp_set_num_threads(current_);
+  /// Sets OpenMP's thread count for the next step. Going from one thread to the full team, it
+  /// first wakes the parked threads with an empty parallel region, outside the step's timing:
+  /// waking a halted virtual CPU took up to a millisecond on the development VM, longer than a
+  /// whole 2-thread step of a small problem.
+  void before_step() {
+    if (!enabled_) return;
+    omp_set_num_threads(current_);
+    if (current_ != 1 && woken_ != current_) {
+#pragma omp parallel
+      {
+      }
+    }
+    woken_ = current_;
   }
 
   /// Records the wall seconds of the step just taken and picks the count for the next one.
@@ -57,19 +70,20 @@ class ThreadTuner {
     ++steps_;
     if (current_ == 1) ++single_steps_;
     ++in_phase_;
-    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > chosen_time_) {
-      // The full team's first step, which also wakes the parked threads, is already slower than
-      // the choice: a busy machine. The probe ends here; its timed steps would cost the most
-      // exactly then (docs/performance.md, "Threads").
+    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > sure_margin * chosen_time_) {
+      // The full team's first step is already clearly slower than the choice: a busy machine.
+      // The probe ends here; its timed steps would cost the most exactly then
+      // (docs/performance.md, "Threads"). (Not for a first step only a little slower: it also
+      // carries the particles' data moving to the other cores' caches.)
       end_probe(seconds);
       return;
     }
     const long long length = probing_ ? probe_length() : hold_;
-    if (in_phase_ > length - timed_steps) timed_ += seconds;
+    if (in_phase_ > length - timed_steps) timed_[n_timed_++] = seconds;
     if (in_phase_ < length) return;
-    const double per_step = timed_ / timed_steps;
+    const double per_step = median_timed();
     in_phase_ = 0;
-    timed_ = 0.0;
+    n_timed_ = 0;
     if (!probing_) {
       // End of a hold: time per step of the choice, then a probe of the other count.
       chosen_time_ = per_step;
@@ -93,7 +107,7 @@ class ThreadTuner {
   /// Ends the probe now running, whose steps took per_step each: keeps the faster count.
   void end_probe(double per_step) {
     in_phase_ = 0;
-    timed_ = 0.0;
+    n_timed_ = 0;
     probing_ = false;
     if (per_step < chosen_time_) {
       chosen_ = current_;
@@ -111,9 +125,20 @@ class ThreadTuner {
   int max_ = 1;
   bool enabled_ = false;
   int chosen_ = 1, current_ = 1;
+  int woken_ = 0;  ///< the thread count before_step last set
   bool probing_ = false;
   long long hold_ = 1, in_phase_ = 0;
-  double timed_ = 0.0, chosen_time_ = 0.0;
+  /// The median of the timed steps of the phase: a pause of the virtual machine in one step
+  /// does not decide, nor does one lucky step of a team beside a busy neighbour.
+  [[nodiscard]] double median_timed() const {
+    static_assert(timed_steps == 3, "the median below is of three steps");
+    const auto& t = timed_;
+    return std::max(std::min(t[0], t[1]), std::min(std::max(t[0], t[1]), t[2]));
+  }
+
+  std::array<double, timed_steps> timed_{};
+  int n_timed_ = 0;
+  double chosen_time_ = 0.0;
   long long steps_ = 0, single_steps_ = 0;
 };
 
