@@ -42,25 +42,6 @@ TEST(ThreadTuner, AProbeOfTheTeamEndsAfterItsFirstStepWhenThatIsAlreadySlower) {
   EXPECT_EQ(1000 - single, ThreadTuner::warm_steps + ThreadTuner::timed_steps + 2);
 }
 
-TEST(ThreadTuner, AProbeWhoseFirstStepIsALittleSlowerGoesOn) {
-  // The team's first step of a probe carries the particles' data moving between the cores'
-  // caches: 1.2x one thread's step (within sure_margin), the timed steps after it 0.5x. The
-  // probe goes on, and the team wins.
-  ThreadTuner tuner(2, true);
-  drive(tuner, 40, 3e-3, 1e-3);  // busy at first: one thread
-  ASSERT_EQ(tuner.threads(), 1);
-  int previous = 1;
-  for (int s = 0; s < 2000 && tuner.threads() == 1; ++s) {
-    tuner.before_step();
-    const int now = tuner.threads();
-    tuner.after_step(now == 1 ? 1e-3 : previous == 1 ? 1.2e-3 : 0.5e-3);
-    previous = now;
-  }
-  EXPECT_EQ(tuner.threads(), 2);
-  EXPECT_LT(tuner.steps(), 40 + 300);  // within the hold that followed the busy phase
-  omp_set_num_threads(1);
-}
-
 TEST(ThreadTuner, OnePausedStepDoesNotDecide) {
   // Idle machine (team 0.5 ms, one thread 1 ms), but the virtual machine pauses for 5 ms in the
   // last timed step of the first hold: the phase counts the median of its timed steps, and the

@@ -6,7 +6,7 @@
 // two cores. Neither can be known before the run, and the load changes during it, so the run
 // loop times its steps: it holds the current choice for a while, then runs a short probe with
 // the other count and keeps whichever was faster per step (a probe of the full team ends after
-// its first step when that is already clearly slower than one thread). The hold grows while the
+// its first step when that is already slower than one thread). The hold grows while the
 // choice stays the same (the probes cost less and less of the run) and shrinks again when it
 // changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
@@ -70,11 +70,10 @@ class ThreadTuner {
     ++steps_;
     if (current_ == 1) ++single_steps_;
     ++in_phase_;
-    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > sure_margin * chosen_time_) {
-      // The full team's first step is already clearly slower than the choice: a busy machine.
-      // The probe ends here; its timed steps would cost the most exactly then
-      // (docs/performance.md, "Threads"). (Not for a first step only a little slower: it also
-      // carries the particles' data moving to the other cores' caches.)
+    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > chosen_time_) {
+      // The full team's first step (its threads woken beforehand, untimed) is already slower
+      // than the choice: a busy machine. The probe ends here; its timed steps would cost the
+      // most exactly then (docs/performance.md, "Threads").
       end_probe(seconds);
       return;
     }
