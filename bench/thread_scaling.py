@@ -4,7 +4,9 @@
 For each problem of bench/problems/ (compare_baseline.py's a-d), runs `cairn run -t 1` and, for
 each setting, `-t 2` in rounds (the order rotates from round to round) and prints the median
 particle-steps/s and the median per-round speed-up over the round's 1-thread run, first alone,
-then while one busy-looping process (/usr/bin/python3 spinning) competes for the cores.
+then while one busy-looping process (/usr/bin/python3 spinning) competes for the cores. Each
+round also prints the steal time of /proc/stat over the round: CPU time the hypervisor gave to
+other guests, which marks the slow periods of a virtual machine.
 
   /usr/bin/python3 bench/thread_scaling.py [--cairn build/release/cairn] [--problems a d]
       [--pairs 3] [--settings default PASSIVE spin=1000 fixed:spin=1000] [--steps-scale 1]
@@ -48,6 +50,13 @@ def run(binary, problem, threads, setting, scratch, scale):
                 os.environ[k] = v
 
 
+def steal_ms():
+    """Milliseconds of CPU time the hypervisor gave to other guests (/proc/stat, all CPUs)."""
+    with open("/proc/stat") as f:
+        fields = f.readline().split()
+    return int(fields[8]) * 1000.0 / os.sysconf("SC_CLK_TCK") if len(fields) > 8 else 0.0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cairn", default=os.path.join(cb.ROOT, "build", "release", "cairn"))
@@ -72,13 +81,16 @@ def main():
                 for r in range(args.pairs):
                     k = r % len(configs)
                     order = configs[k:] + configs[:k]
+                    steal = steal_ms()
                     res = {c: run(args.cairn, prob, c[0], c[1], scratch, args.steps_scale) for c in order}
+                    steal = steal_ms() - steal
                     for c in configs:
                         got[c].append(res[c])
                     for s in args.settings:
                         ratios[s].append(res[(2, s)] / res[(1, "default")])
                     print(f"  ({prob}) {'busy' if busy else 'alone'} round {r + 1}: 1 thread {res[(1, 'default')]:.3g}; "
-                          + ", ".join(f"{s} {res[(2, s)] / res[(1, 'default')]:.2f}" for s in args.settings), flush=True)
+                          + ", ".join(f"{s} {res[(2, s)] / res[(1, 'default')]:.2f}" for s in args.settings)
+                          + f"; steal {steal:.0f} ms", flush=True)
                 for s in args.settings:
                     rows.append((prob, "busy" if busy else "alone", s, statistics.median(got[(1, "default")]),
                                  statistics.median(got[(2, s)]), statistics.median(ratios[s]), min(ratios[s]),
