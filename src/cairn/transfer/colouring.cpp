@@ -88,7 +88,8 @@ void colour_blocks(const Grid<D>& grid, const Particles<D>& particles, TransferC
     if (any_changed) {  // the same for every thread
       const auto [first_k, last_k] = in_id_order ? static_range(n_seq, t, T) : std::pair{first, last};
       const auto particle_at = [&](std::int64_t k) { return in_id_order ? cache.id_order[k] : static_cast<std::int32_t>(k); };
-      // Each thread's counts in a row of whole cache lines (no line written by two cores).
+      // Each thread's counts in a row padded to 64 bytes (neighbouring rows share at most one
+      // cache line).
       const std::size_t row = (static_cast<std::size_t>(total_blocks) + 15) / 16 * 16;
 #pragma omp single
       cache.cursor.assign(T * row, 0);
