@@ -3,7 +3,9 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "cairn/fem/gmsh_module.hpp"
 #include "cairn/fem/mesh.hpp"

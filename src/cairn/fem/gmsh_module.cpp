@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <filesystem>
 #include <mutex>
 #include <numbers>
 #include <stdexcept>

@@ -50,9 +50,9 @@ class ThreadTuner {
   [[nodiscard]] long long steps() const { return steps_; }
 
   /// Sets OpenMP's thread count for the next step. Going from one thread to the full team, it
-  /// first wakes the parked threads with an empty parallel region, outside the step's timing:
-  /// waking a halted virtual CPU took up to a millisecond on the development VM, longer than a
-  /// whole 2-thread step of a small problem.
+  /// first wakes the parked threads with an empty parallel region, outside the step's timing, so
+  /// that the team's first step is timed as a team step and not as a wake-up (which on a virtual
+  /// machine means waking a halted virtual CPU).
   void before_step() {
     if (!enabled_) return;
     omp_set_num_threads(current_);
