@@ -43,6 +43,7 @@ struct Domain {
   Vec<D> xi;                               ///< particle position in cell units
   Eigen::Matrix<double, D, D> Rc;          ///< half edges in cell units (columns)
   std::array<Vec<D>, n_corners> corner;    ///< corner positions in cell units
+  std::array<IVec<D>, n_corners> first;    ///< each corner's first node per axis (Fn::first_node)
   IVec<D> lo, dims;                        ///< node box: first node and nodes per axis
   bool fallback = false;                   ///< GIMP of the undeformed box instead
   Vec<D> half;                             ///< fallback: box half-width in cells
@@ -57,9 +58,13 @@ Vec<D> corner_sign(int c) {
 }
 
 /// Corners, guard decision and node box; cheap enough to run twice per step. The box is taken
-/// from the corners as computed here, so both passes agree to the last bit.
+/// from the corners as computed here, so both passes agree to the last bit. The corners' first
+/// nodes are kept for the weights (one floor per corner and axis, not two). Inlined, as is
+/// accumulate_fixed: out of line the Domain went through the stack on every particle
+/// (docs/performance.md, seventh session).
 template <int D, class Fn>
-Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_t p, double max_span) {
+[[gnu::always_inline]] inline Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_t p,
+                                                    double max_span) {
   Domain<D> dom;
   const Vec<D> inv_h = grid.cell_size().cwiseInverse();
   dom.xi = grid.to_cell_units(parts.position[p]);
@@ -85,7 +90,7 @@ Domain<D> make_domain(const Grid<D>& grid, const Particles<D>& parts, std::size_
   for (int c = 0; c < Domain<D>::n_corners; ++c) {
     dom.corner[c] = dom.xi + dom.Rc * corner_sign<D>(c);
     for (int a = 0; a < D; ++a) {
-      const int f = Fn::first_node(dom.corner[c][a]);
+      const int f = dom.first[c][a] = Fn::first_node(dom.corner[c][a]);
       dom.lo[a] = std::min(dom.lo[a], f);
       hi[a] = std::max(hi[a], f);
     }
@@ -115,8 +120,8 @@ struct FixedBox {
 /// Accumulate S_i = 2^-D sum_c N_i(x_c) and G_i = sum_c N_i(x_c) g_c into a FixedBox; g holds
 /// the corner gradients g_c = 2^-D R^-T s_c (physical units).
 template <int D, class Fn>
-void accumulate_fixed(const Domain<D>& dom, const std::array<Vec<D>, (1 << D)>& g,
-                      FixedBox<D, Fn>& box) {
+[[gnu::always_inline]] inline void accumulate_fixed(const Domain<D>& dom, const std::array<Vec<D>, (1 << D)>& g,
+                                                   FixedBox<D, Fn>& box) {
   using Entry = typename FixedBox<D, Fn>::Entry;
   constexpr int nn = Fn::n_nodes;
   constexpr int W = FixedBox<D, Fn>::width;
@@ -134,7 +139,8 @@ void accumulate_fixed(const Domain<D>& dom, const std::array<Vec<D>, (1 << D)>& 
     double v[D][nn];
     int base = 0, scale = 1;
     for (int a = 0; a < D; ++a) {
-      base += (Fn::weights(dom.corner[c][a], v[a]) - dom.lo[a]) * scale;
+      Fn::weights_from(dom.corner[c][a], dom.first[c][a], v[a]);
+      base += (dom.first[c][a] - dom.lo[a]) * scale;
       scale *= W;
     }
     const Entry gc = update[c];
@@ -313,8 +319,10 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
           for (int c = 0; c < n_corners; ++c) {
             std::array<std::array<double, nn>, D> v;
             int base = 0;
-            for (int a = 0; a < D; ++a)
-              base += (Fn::weights(dom.corner[c][a], v[a].data()) - dom.lo[a]) * stride[a];
+            for (int a = 0; a < D; ++a) {
+              Fn::weights_from(dom.corner[c][a], dom.first[c][a], v[a].data());
+              base += (dom.first[c][a] - dom.lo[a]) * stride[a];
+            }
             for (int idx = 0; idx < cpdi_detail::ipow(nn, D); ++idx) {
               int rem = idx, at = base;
               double N = 1.0;

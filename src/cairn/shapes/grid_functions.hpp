@@ -65,9 +65,13 @@ struct LinearGridFunction {
   /// Values at the n_nodes nodes from first_node(xi); returns first_node(xi).
   static int weights(double xi, double* w) {
     const double f = std::floor(xi);
-    w[1] = xi - f;
-    w[0] = 1.0 - w[1];
+    weights_from(xi, static_cast<int>(f), w);
     return static_cast<int>(f);
+  }
+  /// weights(xi, w) when first_node(xi) is already known (the same values to the last bit).
+  static void weights_from(double xi, int first, double* w) {
+    w[1] = xi - first;
+    w[0] = 1.0 - w[1];
   }
 };
 
@@ -80,12 +84,16 @@ struct QuadraticGridFunction {
   static int first_node(double xi) { return static_cast<int>(std::floor(xi + 0.5)) - 1; }
   static constexpr int n_nodes = 3;
   static int weights(double xi, double* w) {
-    const double c = std::floor(xi + 0.5);
-    const double d = xi - c;
+    const int first = first_node(xi);
+    weights_from(xi, first, w);
+    return first;
+  }
+  /// weights(xi, w) when first_node(xi) is already known (the same values to the last bit).
+  static void weights_from(double xi, int first, double* w) {
+    const double d = xi - (first + 1);
     w[0] = 0.5 * (0.5 - d) * (0.5 - d);
     w[1] = 0.75 - d * d;
     w[2] = 0.5 * (0.5 + d) * (0.5 + d);
-    return static_cast<int>(c) - 1;
   }
 };
 
