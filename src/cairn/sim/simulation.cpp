@@ -787,31 +787,39 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   // loop is compiled without tests for the plain step (all three sums, no affine part, no body
   // force).
   using MatD = Eigen::Matrix<double, D, D>;
+  // The node arrays through raw pointers read once, offset by the particle's field: Eigen's
+  // stores may alias anything, so through the std::vectors every entry reloaded their data
+  // pointers (as in lumped_projection).
+  double* const mass_all = nodes_.mass.data();
+  Vec<D>* const momentum_all = nodes_.momentum.data();
+  Vec<D>* const force_all = nodes_.force.data();
   auto extrapolate = [&](auto plain_tag) {
     constexpr bool plain = decltype(plain_tag)::value;
     scatter(cache_, [&](std::int32_t p, const auto& stencil) {
       const std::int32_t off = field_offset(p);
+      double* const mass = mass_all + off;
+      Vec<D>* const momentum = momentum_all + off;
+      Vec<D>* const force_at = force_all + off;
       const double M = P.mass[p];
       const Vec<D> V = P.velocity[p];
       const MatD stress = -P.volume0[p] * P.kirchhoff_stress[p].template block<D>();
       stencil.for_each_force(stress, [&](std::int32_t node, double S, const Vec<D>& force) {
-        const std::int32_t i = node + off;
         const double Sm = S * M;
         if (plain || mass_and_momentum) {
-          nodes_.mass[i] += Sm;
+          mass[node] += Sm;
           if (!plain && affine) {
             const Vec<D> dx = node_offset(grid_, node, P.position[p]);
-            nodes_.momentum[i] += Sm * (V + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
+            momentum[node] += Sm * (V + P.affine_velocity[p].template topLeftCorner<D, D>() * dx);
           } else {
-            nodes_.momentum[i] += Sm * V;
+            momentum[node] += Sm * V;
           }
         }
         if (plain || forces) {
-          nodes_.force[i] += force;
+          force_at[node] += force;
           if (!plain && has_body_force) {
             const Vec<D> fb = Sm * (body_force_constant_ ? body_force_value_ : body_acceleration_[p]);
-            nodes_.force[i] += fb;
-            node_body_force_[i] += fb;
+            force_at[node] += fb;
+            node_body_force_[node + off] += fb;
           }
         }
       });
@@ -919,15 +927,23 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
     // One pass: each particle's U_p is formed and scattered while its stencil is at hand (`in`
     // is only read, so the colour sweep may gather it; the same sums in the same order).
     for_each_node(n_slots(), [&](std::int32_t i) { out[i].setZero(); });
-    scatter(cache_, [&](std::int32_t p, const auto& stencil) {
+    // Through raw pointers read once, the particle's field offset added to them: Eigen's vector
+    // stores may alias anything, so through the std::vectors every entry reloaded their data
+    // pointers and added the offset to the node.
+    const Vec<D>* const in_all = in.data();
+    Vec<D>* const out_all = out.data();
+    const double* const mass = particles_.mass.data();
+    scatter(cache_, [&, in_all, out_all, mass](std::int32_t p, const auto& stencil) {
       const std::int32_t off = field_offset(p);
+      const Vec<D>* const in_f = in_all + off;
+      Vec<D>* const out_f = out_all + off;
       double u[D] = {};
       stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) {
-        for (int a = 0; a < D; ++a) u[a] += S * in[node + off][a];
+        for (int a = 0; a < D; ++a) u[a] += S * in_f[node][a];
       });
       const Vec<D> U(u);
-      const double M = particles_.mass[p];  // read once (the stores to `out` might alias it)
-      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { out[node + off] += (S * M) * U; });
+      const double M = mass[p];
+      stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { out_f[node] += (S * M) * U; });
     });
   } else {
     lumped_projection_distributed(in, out);
