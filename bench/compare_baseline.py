@@ -9,7 +9,7 @@ the per-pair ratios. Wall-clock figures on a shared machine are noisy; the per-p
 robust one. Each run's own figure is the run loop's rate from `cairn run`'s summary line.
 
   /usr/bin/python3 bench/compare_baseline.py [--baseline 9d0b960] [--pairs 5] [--threads 1]
-      [--problems a b c d] [--no-build] [--steps-scale 1.0]
+      [--problems a b c d] [--no-build] [--steps-scale 1.0] [--quiet-check]
 
 Problems (bench/problems/*.toml):
   a  two blocks, CPDI, FLIP/USL, neo-Hookean, 8000 particles (seed 000 Sec. 3.1)
@@ -73,6 +73,33 @@ def run_once(binary, problem, threads, scratch, scale, more=()):
     return float(m.group(3))
 
 
+def side_by_side(binary, scratch):
+    """Two 1-thread runs of problem (a) started together, one per core, and their particle-steps/s.
+
+    On a virtual machine the host's load comes and goes for minutes; in its slow periods one or
+    both cores run slower (docs/performance.md, "The slow periods"), and ratios measured then are
+    lower than on a quiet machine. Both copies near a lone 1-thread run's rate mark a quiet core
+    pair; one or both well below it mark a block to repeat.
+    """
+    toml, extra = PROBLEMS["a"]
+    procs = []
+    for k in range(2):
+        cmd = [binary, "run", os.path.join(ROOT, "bench", "problems", toml), "-t", "1",
+               "--set", f"output.directory={scratch}-side{k}"] + list(extra)
+        procs.append(subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True))
+    rates = []
+    for proc in procs:
+        out, _ = proc.communicate()
+        m = SUMMARY.search(out)
+        rates.append(float(m.group(3)) if m else float("nan"))
+    return rates
+
+
+def quiet_line(binary, scratch):
+    a, b = side_by_side(binary, scratch)
+    return f"two 1-thread copies of (a) side by side: {a / 1e6:.2f} M and {b / 1e6:.2f} M"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--baseline", default="9d0b960")
@@ -83,6 +110,9 @@ def main():
     ap.add_argument("--no-build", action="store_true", help="use the binaries already built")
     ap.add_argument("--current", default=None, help="current binary (default build/release/cairn)")
     ap.add_argument("--steps-scale", type=float, default=1.0, help="scale every problem's step count")
+    ap.add_argument("--quiet-check", action="store_true",
+                    help="before and after the block, run two 1-thread copies of (a) side by side with the "
+                         "current binary and print their rates (both near a lone run's: quiet cores)")
     args = ap.parse_args()
     tree = args.tree or f"/tmp/cairn-baseline-{args.baseline}"
     if args.no_build:
@@ -94,6 +124,8 @@ def main():
     scratch = f"/tmp/cairn-compare-{os.getpid()}"
     print(f"baseline {args.baseline}: {base_bin}\ncurrent: {cur_bin}\nthreads {args.threads}, "
           f"{args.pairs} pairs per problem, load average {os.getloadavg()[0]:.1f} at start", flush=True)
+    if args.quiet_check:
+        print("before: " + quiet_line(cur_bin, scratch), flush=True)
     rows = []
     for prob in args.problems:
         base, cur, ratios = [], [], []
@@ -112,6 +144,8 @@ def main():
         rows.append((prob, statistics.median(base), statistics.median(cur),
                      statistics.median(cur) / statistics.median(base), statistics.median(ratios),
                      min(ratios), max(ratios)))
+    if args.quiet_check:
+        print("after: " + quiet_line(cur_bin, scratch), flush=True)
     print(f"\nload average {os.getloadavg()[0]:.1f} at end; particle-steps/s, {args.threads} thread(s), "
           f"medians of {args.pairs} alternating pairs")
     print("| problem | baseline | current | ratio of medians | median pair ratio (min-max) |")

@@ -10,6 +10,7 @@ other guests, which marks the slow periods of a virtual machine.
 
   /usr/bin/python3 bench/thread_scaling.py [--cairn build/release/cairn] [--problems a d]
       [--pairs 3] [--settings default PASSIVE spin=1000 fixed:spin=1000] [--steps-scale 1]
+      [--only alone|busy] [--quiet-check]
 
 A setting is the OpenMP wait policy of the 2-thread run: "default" leaves OMP_WAIT_POLICY and
 GOMP_SPINCOUNT unset (what a user gets: cairn picks its own default, app/main.cpp), PASSIVE or
@@ -65,8 +66,14 @@ def main():
     ap.add_argument("--settings", nargs="+", default=["default", "fixed:default", "fixed:PASSIVE"])
     ap.add_argument("--steps-scale", type=float, default=1.0)
     ap.add_argument("--only", choices=["alone", "busy"], default=None)
+    ap.add_argument("--quiet-check", action="store_true",
+                    help="before and after the runs alone, two 1-thread copies of (a) side by side "
+                         "(compare_baseline.side_by_side): both near a lone run's rate mark quiet cores")
     args = ap.parse_args()
     scratch = f"/tmp/cairn-threads-{os.getpid()}"
+    quiet = args.quiet_check and args.only != "busy"
+    if quiet:
+        print("before: " + cb.quiet_line(args.cairn, scratch), flush=True)
     rows = []
     for busy in (False, True):
         if args.only and args.only != ("busy" if busy else "alone"):
@@ -99,6 +106,8 @@ def main():
             if neighbour:
                 neighbour.kill()
                 neighbour.wait()
+        if quiet and not busy:
+            print("after: " + cb.quiet_line(args.cairn, scratch), flush=True)
     print(f"\nload average {os.getloadavg()[0]:.1f} at end; particle-steps/s, medians of {args.pairs} rounds; "
           "'busy': one CPU-bound process beside the run; load: 1-minute load average at the start of the block")
     print("| problem | machine | load | 2-thread setting | 1 thread | 2 threads | 2 / 1 (min-max) |")
