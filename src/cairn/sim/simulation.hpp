@@ -225,6 +225,15 @@ class Simulation {
   void subtract_contact_term(std::vector<Vec<D>>& out, int k);
   /// Entries of the node arrays: n_nodes, times the number of fields in multimaterial mode.
   [[nodiscard]] std::int32_t n_slots() const { return grid_.n_nodes() * n_fields_; }
+  /// The storage range from the first to the last node slot with mass (one field, one rank;
+  /// the whole grid otherwise).
+  [[nodiscard]] std::pair<std::int32_t, std::int32_t> occupied_slots() const;
+  /// fn(i) for the node slots of the full-mass expansion's range.
+  template <class Fn>
+  void for_each_fm_node(Fn&& fn) {
+    const std::int32_t first = fm_first_, last = fm_last_ < 0 ? n_slots() : fm_last_;
+    for_each_node(last - first, [&](std::int32_t k) { fn(first + k); });
+  }
   /// Offset of particle p's field in the node arrays (multimaterial mode; 0 otherwise).
   [[nodiscard]] std::int32_t field_offset(std::int64_t p) const { return contact_ ? field_offset_[p] : 0; }
   /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
@@ -254,6 +263,9 @@ class Simulation {
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
+  /// Node slots [first, last) the full-mass expansion visits: every slot with mass this step
+  /// (occupied_slots); the whole grid outside full_mass_velocity.
+  std::int32_t fm_first_ = 0, fm_last_ = -1;
   std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)
   double dissipated_energy_ = 0.0;
   double step_dt_ = 0.0;
