@@ -921,12 +921,13 @@ void Simulation<D>::update_grid(double dt) {
 
 template <int D>
 template <class Finish>
-void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish) {
+void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish,
+                                      SlotRange slots) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
   if (!distributed()) {
     // One pass: each particle's U_p is formed and scattered while its stencil is at hand (`in`
     // is only read, so the colour sweep may gather it; the same sums in the same order).
-    for_each_fm_node([&](std::int32_t i) { out[i].setZero(); });
+    for_each_node(slots, [&](std::int32_t i) { out[i].setZero(); });
     // Through raw pointers read once, the particle's field offset added to them: Eigen's vector
     // stores may alias anything, so through the std::vectors every entry reloaded their data
     // pointers and added the offset to the node.
@@ -948,7 +949,7 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
   } else {
     lumped_projection_distributed(in, out);
   }
-  for_each_fm_node([&](std::int32_t i) {
+  for_each_node(slots, [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     out[i] = m > small_mass_ ? Vec<D>(out[i] / m) : Vec<D>::Zero();
     finish(i, out[i]);
@@ -996,15 +997,8 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
                                  (from_p || from_p_new);
   // Slots without mass take no part (no particle reads them): the expansion visits the range
   // from the first to the last slot with mass. Beyond it `out` keeps what it held.
-  std::tie(fm_first_, fm_last_) = occupied_slots();
-  const struct WholeGridAfter {  // other callers of lumped_projection visit every slot
-    Simulation& sim;
-    ~WholeGridAfter() {
-      sim.fm_first_ = 0;
-      sim.fm_last_ = -1;
-    }
-  } whole_grid_after{*this};
-  for_each_fm_node([&](std::int32_t i) {
+  const SlotRange slots = occupied_slots();
+  for_each_node(slots, [&](std::int32_t i) {
     const double m = nodes_.mass[i];
     if (!uncorrected_start) grid_term_[i] = in[i];
     else if (m <= small_mass_) grid_term_[i].setZero();
@@ -1012,7 +1006,7 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
   });
   using When = typename VelocityConditions<D>::When;
   const When when = from_p ? When::start : from_p_new ? When::end : work_when_;
-  for_each_fm_node([&](std::int32_t i) { out[i] = grid_term_[i]; });
+  for_each_node(slots, [&](std::int32_t i) { out[i] = grid_term_[i]; });
   if (method == "constrained") {
     // Truncated Neumann series of the constrained system: the held components take their
     // prescribed values and the free ones solve (S+S)_ff v_f = v_f^(L) - (S+S)_fc v_c. As the
@@ -1023,22 +1017,25 @@ void Simulation<D>::full_mass_velocity(const std::vector<Vec<D>>& in, std::vecto
     // `combined` (conditions on the start and the end only) approaches (K^-1)_ff K_ff, whose
     // eigenvalues are >= 1 (docs/boundary-conditions.md).
     for (int j = 1; j < k; ++j) {
-      lumped_projection(out, grid_proj_);
-      for_each_fm_node([&](std::int32_t i) { out[i] += grid_term_[i] - grid_proj_[i]; });
+      lumped_projection(out, grid_proj_, [](std::int32_t, const Vec<D>&) {}, slots);
+      for_each_node(slots, [&](std::int32_t i) { out[i] += grid_term_[i] - grid_proj_[i]; });
       impose_conditions(out, when);
     }
     return;
   }
   for (int j = 1; j < k; ++j)
-    lumped_projection(grid_term_, grid_proj_, [&](std::int32_t i, const Vec<D>& projected) {
-      grid_term_[i] -= projected;  // A^j in
-      out[i] += grid_term_[i];
-    });
+    lumped_projection(
+        grid_term_, grid_proj_,
+        [&](std::int32_t i, const Vec<D>& projected) {
+          grid_term_[i] -= projected;  // A^j in
+          out[i] += grid_term_[i];
+        },
+        slots);
   if (method != "lumped") impose_conditions(out, when);
 }
 
 template <int D>
-std::pair<std::int32_t, std::int32_t> Simulation<D>::occupied_slots() const {
+SlotRange Simulation<D>::occupied_slots() const {
   const std::int32_t n = n_slots();
   if (distributed() || n_fields_ > 1) return {0, n};
   std::int32_t first = 0, last = n;
@@ -1072,10 +1069,13 @@ void Simulation<D>::subtract_contact_term(std::vector<Vec<D>>& out, int k) {
     out[i] -= grid_term_[i];
   });
   for (int j = 1; j < k - 1; ++j)
-    lumped_projection(grid_term_, grid_proj_, [&](std::int32_t i, const Vec<D>& projected) {
-      grid_term_[i] -= projected;
-      out[i] -= grid_term_[i];
-    });
+    lumped_projection(
+        grid_term_, grid_proj_,
+        [&](std::int32_t i, const Vec<D>& projected) {
+          grid_term_[i] -= projected;
+          out[i] -= grid_term_[i];
+        },
+        {0, n_slots()});
 }
 
 template <int D>

@@ -26,6 +26,7 @@
 #include "cairn/thermal/conduction.hpp"
 #include "cairn/transfer/cache.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/util/parallel.hpp"
 
 namespace cairn {
 
@@ -83,10 +84,13 @@ class Simulation {
   void full_mass_velocity(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, int k);
   /// out = S+ S in: grid -> particles -> grid with the lumped reverse map (seed 000 Sec. 2.1).
   /// out = S+ S in, then finish(i, out_i) in the same node loop (the caller's use of the result).
+  /// Its node loops visit `slots` only (every slot with mass must lie in it; the others keep
+  /// what they held).
   template <class Finish>
-  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish);
+  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish,
+                         SlotRange slots);
   void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
-    lumped_projection(in, out, [](std::int32_t, const Vec<D>&) {});
+    lumped_projection(in, out, [](std::int32_t, const Vec<D>&) {}, {0, n_slots()});
   }
   void lumped_projection_distributed(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
 
@@ -227,13 +231,7 @@ class Simulation {
   [[nodiscard]] std::int32_t n_slots() const { return grid_.n_nodes() * n_fields_; }
   /// The storage range from the first to the last node slot with mass (one field, one rank;
   /// the whole grid otherwise).
-  [[nodiscard]] std::pair<std::int32_t, std::int32_t> occupied_slots() const;
-  /// fn(i) for the node slots of the full-mass expansion's range.
-  template <class Fn>
-  void for_each_fm_node(Fn&& fn) {
-    const std::int32_t first = fm_first_, last = fm_last_ < 0 ? n_slots() : fm_last_;
-    for_each_node(last - first, [&](std::int32_t k) { fn(first + k); });
-  }
+  [[nodiscard]] SlotRange occupied_slots() const;
   /// Offset of particle p's field in the node arrays (multimaterial mode; 0 otherwise).
   [[nodiscard]] std::int32_t field_offset(std::int64_t p) const { return contact_ ? field_offset_[p] : 0; }
   /// Every velocity condition ([boundary] faces, then [[velocity]], then [[wall]]) on one field,
@@ -263,9 +261,6 @@ class Simulation {
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
-  /// Node slots [first, last) the full-mass expansion visits: every slot with mass this step
-  /// (occupied_slots); the whole grid outside full_mass_velocity.
-  std::int32_t fm_first_ = 0, fm_last_ = -1;
   std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)
   double dissipated_energy_ = 0.0;
   double step_dt_ = 0.0;

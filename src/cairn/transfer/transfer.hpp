@@ -384,4 +384,11 @@ void for_each_node(std::int32_t n_nodes, Fn&& fn) {
   for (std::int32_t i = 0; i < n_nodes; ++i) fn(i);
 }
 
+/// for_each_node over the slots of `range` only.
+template <class Fn>
+void for_each_node(SlotRange range, Fn&& fn) {
+  const std::int32_t first = range.first;
+  for_each_node(range.last - first, [&](std::int32_t k) { fn(first + k); });
+}
+
 }  // namespace cairn

@@ -21,6 +21,12 @@ inline constexpr std::int64_t parallel_min_items = 32768;
 /// than with parallel_min_items; docs/performance.md, "Threads").
 inline constexpr std::int64_t node_loop_min = 4096;
 
+/// A range [first, last) of node slots (storage indices) for a node loop (transfer.hpp,
+/// for_each_node).
+struct SlotRange {
+  std::int32_t first = 0, last = 0;
+};
+
 /// Particle affinity. Every particle stage of a step (stencil build, gathers, scatters) gives a
 /// particle to the same thread while the particles are few enough for their data to stay in the
 /// cores' caches: thread t of T takes the particles of static_range(n, t, T) in the loops over
