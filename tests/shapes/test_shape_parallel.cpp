@@ -6,8 +6,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <numeric>
 #include <random>
+#include <thread>
 
 #include "../support/config_builder.hpp"
 #include "cairn/sim/names.hpp"
@@ -108,6 +111,69 @@ TEST(ParticleAffinity, StaticRangesPartitionTheParticles) {
       ASSERT_EQ(next, n);
     }
   }
+}
+
+// Particle affinity with stealing (util/parallel.hpp): for any team, every item is handed out
+// exactly once; a thread keeps its static_range while the team runs evenly, and when one thread
+// is slowed the others take part of its range.
+TEST(ParticleAffinity, StealingShareCoversEveryItemOnceAndHelpsASlowThread) {
+  for (int T : {1, 2, 3, 4}) {
+    for (std::int64_t n : {0, 1, 17, 1000, 100003}) {
+      omp_set_num_threads(T);
+      StealingShare share(n);
+      std::vector<int> done(static_cast<std::size_t>(n), 0), by(static_cast<std::size_t>(n), -1);
+#pragma omp parallel
+      {
+        auto cursor = share.cursor();
+        for (std::int64_t first, last; cursor.next(first, last);)
+          for (std::int64_t i = first; i < last; ++i) {
+            ++done[i];  // a race (and a count of 2) if two threads got the item
+            by[i] = omp_get_thread_num();
+          }
+      }
+      for (std::int64_t i = 0; i < n; ++i) ASSERT_EQ(done[i], 1) << "T " << T << " n " << n << " item " << i;
+    }
+  }
+  // Thread 1 sleeps in every chunk it takes: thread 0 ends up with more than its half. (Thread 0
+  // starts once thread 1 holds its first chunk, so that a late thread 1 is not left with nothing.)
+  omp_set_num_threads(2);
+  const std::int64_t n = 64000;
+  StealingShare share(n);
+  std::vector<int> by(static_cast<std::size_t>(n), -1);
+  int team = 0;
+  std::atomic<bool> started{false};
+#pragma omp parallel
+  {
+    team = omp_get_num_threads();
+    const int t = omp_get_thread_num();
+    auto cursor = share.cursor();
+    if (t == 0)
+      while (!started.load()) std::this_thread::yield();
+    for (std::int64_t first, last; cursor.next(first, last);) {
+      if (t == 1) {
+        started.store(true);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+      for (std::int64_t i = first; i < last; ++i) by[i] = t;
+    }
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  ASSERT_EQ(team, 2);
+  const auto by_0 = std::count(by.begin(), by.end(), 0);
+  EXPECT_EQ(std::count(by.begin(), by.end(), -1), 0);
+  EXPECT_GT(by_0, 3 * n / 4);
+  // What thread 0 took from thread 1 came from the back of thread 1's half: the front of that
+  // half stayed with thread 1.
+  EXPECT_EQ(by[n / 2], 1);
+  // An if(false) region (a team of 1, not the one the share was made for) gets the static range.
+  StealingShare serial(10);
+  std::int64_t covered = 0;
+#pragma omp parallel if (false)
+  {
+    auto cursor = serial.cursor();
+    for (std::int64_t first, last; cursor.next(first, last);) covered += last - first;
+  }
+  EXPECT_EQ(covered, 10);
 }
 
 // Beyond affinity_max_particles the gathers and scatters hand out work dynamically: the results

@@ -249,6 +249,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
   first_bad = INT64_MAX;
   lo.setZero();
   hi.setZero();
+  StealingShare share(n);
 #pragma omp parallel
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
@@ -261,8 +262,10 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       w1[a].resize(widest);
       dw1[a].resize(widest);
     }
-    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
-    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    // Each thread builds the particles it later gathers and scatters, and helps a slower one
+    // (util/parallel.hpp).
+    auto cursor = share.cursor();
+    for (std::int64_t first_p, last_p; cursor.next(first_p, last_p);)
     for (std::int64_t p = first_p; p < last_p; ++p) {
       if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
         bad_t = std::min<std::int64_t>(bad_t, p);

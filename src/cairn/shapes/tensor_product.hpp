@@ -47,12 +47,15 @@ void build_factored(const Kernel& kernel, const Grid<D>& grid, const Particles<D
                     TransferCache<D>& cache, IVec<D>& lo, IVec<D>& hi, std::int64_t& first_bad) {
   const auto n = static_cast<std::int64_t>(particles.n());
   const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+  StealingShare share(n);
 #pragma omp parallel
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
-    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
-    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    // Each thread builds the particles it later gathers and scatters, and helps a slower one
+    // (util/parallel.hpp).
+    auto cursor = share.cursor();
+    for (std::int64_t first_p, last_p; cursor.next(first_p, last_p);)
     for (std::int64_t p = first_p; p < last_p; ++p) {
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
       std::int32_t* node_out = &cache.axis_node[static_cast<std::size_t>(p) * D * W];
@@ -109,12 +112,15 @@ void build_expanded(const Kernel& kernel, int width, const Grid<D>& grid, const 
   for (int a = 0; a < D; ++a) slots *= width;
   const auto n = static_cast<std::int64_t>(particles.n());
   const Vec<D> inv_h = grid.cell_size().cwiseInverse();
+  StealingShare share(n);
 #pragma omp parallel
   {
     IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
     std::int64_t bad_t = INT64_MAX;
-    // Each thread builds the particles it later gathers and scatters (util/parallel.hpp).
-    const auto [first_p, last_p] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
+    // Each thread builds the particles it later gathers and scatters, and helps a slower one
+    // (util/parallel.hpp).
+    auto cursor = share.cursor();
+    for (std::int64_t first_p, last_p; cursor.next(first_p, last_p);)
     for (std::int64_t p = first_p; p < last_p; ++p) {
       std::array<std::array<double, max_width>, D> w{}, dw{};
       IVec<D> first;

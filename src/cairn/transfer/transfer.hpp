@@ -324,13 +324,14 @@ void scatter(const TransferCache<D>& cache, Fn&& fn) {
 inline constexpr std::int64_t gather_chunk = 512;
 
 /// Calls body(first, last) on every thread for its share of the owned particles [0, n): its
-/// static_range up to affinity_max_particles (the cache's particle count decides, as in
-/// scatter), dynamically handed-out chunks beyond. Call inside a parallel region.
+/// static_range with stealing up to affinity_max_particles (the cache's particle count decides,
+/// as in scatter; `share` made before the region for n), dynamically handed-out chunks beyond.
+/// Call inside a parallel region.
 template <int D, class Body>
-void share_particles(const TransferCache<D>& cache, std::int64_t n, Body&& body) {
+void share_particles(const TransferCache<D>& cache, std::int64_t n, StealingShare& share, Body&& body) {
   if (static_cast<std::int64_t>(cache.n) <= affinity_max_particles) {
-    const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
-    body(first, last);
+    auto cursor = share.cursor();
+    for (std::int64_t first, last; cursor.next(first, last);) body(first, last);
     return;
   }
   const std::int64_t n_chunks = (n + gather_chunk - 1) / gather_chunk;
@@ -348,8 +349,9 @@ void gather(const TransferCache<D>& cache, Fn&& fn) {
     const auto range = [&](std::int64_t first, std::int64_t last) {
       for (std::int64_t p = first; p < last; ++p) fn(p, stencil_of(static_cast<std::size_t>(p)));
     };
+    StealingShare share(n);
 #pragma omp parallel
-    share_particles(cache, n, range);
+    share_particles(cache, n, share, range);
   });
 }
 
@@ -365,10 +367,11 @@ ExactSum gather_sum(const TransferCache<D>& cache, Fn&& fn) {
     const auto add_range = [&](ExactSum& sum, std::int64_t first, std::int64_t last) {
       for (std::int64_t p = first; p < last; ++p) sum.add(fn(p, stencil_of(static_cast<std::size_t>(p))));
     };
+    StealingShare share(n);
 #pragma omp parallel
     {
       ExactSum sum;
-      share_particles(cache, n, [&](std::int64_t first, std::int64_t last) { add_range(sum, first, last); });
+      share_particles(cache, n, share, [&](std::int64_t first, std::int64_t last) { add_range(sum, first, last); });
 #pragma omp critical(cairn_gather_sum)
       total += sum;
     }

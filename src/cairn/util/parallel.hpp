@@ -2,8 +2,10 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <utility>
+#include <vector>
 
 namespace cairn {
 
@@ -51,5 +53,49 @@ inline std::pair<std::int64_t, std::int64_t> static_range(std::int64_t n, int t,
   const std::int64_t begin = t * q + std::min<std::int64_t>(t, r);
   return {begin, begin + q + (t < r ? 1 : 0)};
 }
+
+/// Particle affinity with stealing. Each thread works through its static_range in chunks from the
+/// front; a thread that has finished its own range takes chunks from the back of the others'
+/// unfinished ranges. A thread keeps nearly all of its particles, and the team still finishes
+/// together when one core is slowed (the development VM's cores are, often for seconds;
+/// docs/performance.md, "Threads"). Which thread does an item never changes a result: the loops
+/// that use it work particle by particle and reduce with max, min or exact sums.
+/// Made before the parallel region (for a team of omp_get_max_threads() threads); every thread of
+/// the region takes its cursor(). Out of line (util/parallel.cpp): inlined, its code tipped GCC's
+/// inlining budget in the particle update, which then ran 9 % slower on one thread.
+class StealingShare {
+ public:
+  explicit StealingShare(std::int64_t n);
+
+  /// One thread's walk through the items: next() gives its next range [first, last) until it
+  /// returns false. The ranges of all threads are disjoint and together cover [0, n).
+  class Cursor {
+   public:
+    bool next(std::int64_t& first, std::int64_t& last);
+
+   private:
+    friend class StealingShare;
+    StealingShare* share_ = nullptr;  // null: a static range
+    int t_ = 0, T_ = 1, k_ = 0;
+    std::int64_t first_ = 0, last_ = 0;
+  };
+
+  /// The calling thread's cursor (inside the region). A team other than the one made for (nested,
+  /// or an if clause) gets the static ranges.
+  Cursor cursor();
+
+ private:
+  struct alignas(64) Slot {
+    std::atomic<std::uint64_t> range{0};  // [front, back) of what is left, packed
+  };
+  /// A chunk from the front (the owner) or the back (a thief) of thread u's range; empty when
+  /// nothing is left.
+  std::pair<std::int64_t, std::int64_t> take(int u, bool front);
+
+  std::int64_t n_;
+  int team_;
+  std::int64_t chunk_ = 0;
+  std::vector<Slot> slots_;
+};
 
 }  // namespace cairn
