@@ -2,6 +2,7 @@
 // dF = exp(grad V dt) (seed 000 Table 1, Task 5) and small invariants.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -58,6 +59,78 @@ template <int N>
   }
 }
 
+/// A 3x3 matrix as scalars for the inlined 3D exponential, columns padded to four (the fourth
+/// entry of each column is zero). Eigen's SSE code for a 3x3 matrix stores a product column by
+/// column (a 2-double packet and a scalar) and reads a sum linearly in packets (elements 0-1,
+/// 2-3, ...), so a packet read straddled two earlier stores and waited for them (store-forwarding
+/// stalls, 40 % of the 3D stress-update function in a profile of problem (c),
+/// docs/performance.md). With padded columns, element-wise and column-wise access pair the same
+/// elements, so whatever the compiler keeps in memory is read back as it was stored.
+struct Scalar3 {
+  alignas(16) double v[12];
+  [[gnu::always_inline]] static Scalar3 identity() {
+    return {{1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}};
+  }
+  [[gnu::always_inline]] static Scalar3 of(const Eigen::Matrix3d& m) {
+    Scalar3 r;
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 3; ++i) r.v[i + 4 * j] = m(i, j);
+      r.v[3 + 4 * j] = 0.0;
+    }
+    return r;
+  }
+  [[gnu::always_inline]] Eigen::Matrix3d matrix() const {
+    Eigen::Matrix3d m;
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) m(i, j) = v[i + 4 * j];
+    return m;
+  }
+};
+[[gnu::always_inline]] inline Scalar3 operator+(const Scalar3& x, const Scalar3& y) {
+  Scalar3 r;
+  for (int k = 0; k < 12; ++k) r.v[k] = x.v[k] + y.v[k];
+  return r;
+}
+[[gnu::always_inline]] inline Scalar3 operator*(double c, const Scalar3& x) {
+  Scalar3 r;
+  for (int k = 0; k < 12; ++k) r.v[k] = c * x.v[k];
+  return r;
+}
+/// The matrix product.
+[[gnu::always_inline]] inline Scalar3 operator*(const Scalar3& x, const Scalar3& y) {
+  Scalar3 r;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 4; ++i)  // i = 3: the zero padding (0 * y + ...)
+      r.v[i + 4 * j] = x.v[i] * y.v[4 * j] + x.v[i + 4] * y.v[4 * j + 1] + x.v[i + 8] * y.v[4 * j + 2];
+  return r;
+}
+
+/// exp_small for 3x3 on scalars: the same polynomials.
+[[gnu::always_inline]] inline Scalar3 exp_small3(const Scalar3& A, double b) {
+  int m = 1;
+  for (int k = 1; k < 7; ++k) m += b > threshold[k];  // branch-free: m = 1 .. 7
+  const Scalar3 I = Scalar3::identity();
+  if (m == 1) return I + A;
+  const Scalar3 A2 = A * A;
+  switch (m) {
+    case 2:
+      return I + A + 0.5 * A2;
+    case 3:
+      return I + A + A2 * (0.5 * I + (1.0 / 6) * A);
+    case 4:
+      return I + A + A2 * (0.5 * I + (1.0 / 6) * A + (1.0 / 24) * A2);
+    default: {
+      const Scalar3 A3 = A2 * A;
+      const Scalar3 head = I + A + 0.5 * A2;
+      if (m == 5) return head + A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2);
+      if (m == 6) return head + A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2 + (1.0 / 720) * A3);
+      const Scalar3 A4 = A2 * A2;
+      return head + (1.0 / 6) * A3 +
+             A4 * ((1.0 / 24) * I + (1.0 / 120) * A + (1.0 / 720) * A2 + (1.0 / 5040) * A3);
+    }
+  }
+}
+
 /// Scaling and squaring for |A|_inf = norm > small_limit (see tensor_exp), out of line.
 template <int N>
 [[gnu::noinline]] Eigen::Matrix<double, N, N> exp_large(const Eigen::Matrix<double, N, N>& a, double norm) {
@@ -86,6 +159,21 @@ template <int N>
 
 }  // namespace exp_detail
 
+/// exp(a) of a 3x3 matrix as nine scalars (exp_detail::Scalar3), for a caller that goes on in
+/// scalars (the 3D deformation-gradient update, sim/simulation.cpp): tensor_exp<3> below.
+[[gnu::always_inline]] inline exp_detail::Scalar3 tensor_exp_scalars(const Eigen::Matrix3d& a) {
+  const exp_detail::Scalar3 s = exp_detail::Scalar3::of(a);
+  double norm = 0.0;  // infinity norm
+  for (int i = 0; i < 3; ++i) norm = std::max(norm, std::abs(s.v[i]) + std::abs(s.v[i + 4]) + std::abs(s.v[i + 8]));
+  if (!std::isfinite(norm)) {
+    exp_detail::Scalar3 nan;
+    for (double& x : nan.v) x = std::numeric_limits<double>::quiet_NaN();
+    return nan;
+  }
+  if (norm <= exp_detail::small_limit) return exp_detail::exp_small3(s, norm);
+  return exp_detail::Scalar3::of(exp_detail::exp_large<3>(a, norm));
+}
+
 /// exp(A) for an N x N matrix (N = 1, 2, 3) by scaling and squaring of a Taylor series run to
 /// round-off: exp(A) = (exp(A / 2^s))^(2^s) with s chosen so that b = |A|_inf / 2^s <= 1/2, and
 /// the series sum_k B^k / k! taken until the bound b^k / k! on its last term is below 1e-17 (the
@@ -104,10 +192,14 @@ template <int N>
 template <int N>
 [[gnu::always_inline]] inline Eigen::Matrix<double, N, N> tensor_exp(const Eigen::Matrix<double, N, N>& a) {
   using M = Eigen::Matrix<double, N, N>;
-  const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
-  if (!std::isfinite(norm)) return M::Constant(std::numeric_limits<double>::quiet_NaN());
-  if (norm <= exp_detail::small_limit) return exp_detail::exp_small<N>(a, norm);
-  return exp_detail::exp_large<N>(a, norm);
+  if constexpr (N == 3) {
+    return tensor_exp_scalars(a).matrix();
+  } else {
+    const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
+    if (!std::isfinite(norm)) return M::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (norm <= exp_detail::small_limit) return exp_detail::exp_small<N>(a, norm);
+    return exp_detail::exp_large<N>(a, norm);
+  }
 }
 
 /// The 3x3 case, also for matrix expressions (tensor_exp(L * dt)).

@@ -1279,9 +1279,17 @@ const char* Simulation<D>::update_stress_at(std::int64_t p, const Eigen::Matrix<
   // [[exp(L_D dt), 0], [0, I]] and only the first D rows of F change. The 3x3 increments are
   // assembled only for models that read them (Material::uses_increment).
   static const Mat3 zero = Mat3::Zero(), identity = Mat3::Identity();
-  const Eigen::Matrix<double, D, D> dF_D = tensor_exp<D>(L_D * dt);
   Mat3& F = particles_.deformation_gradient[p];
-  F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+  Eigen::Matrix<double, D, D> dF_D;
+  if constexpr (D == 3) {
+    // In scalars from the exponential to F (math/tensor.hpp, exp_detail::Scalar3).
+    const exp_detail::Scalar3 dF3 = tensor_exp_scalars(L_D * dt);
+    F = (dF3 * exp_detail::Scalar3::of(F)).matrix();
+    if (increments) dF_D = dF3.matrix();
+  } else {
+    dF_D = tensor_exp<D>(L_D * dt);
+    F.template topRows<D>() = (dF_D * F.template topRows<D>()).eval();
+  }
   if (increments) {
     Mat3 L = Mat3::Zero(), dF = Mat3::Identity();
     L.template topLeftCorner<D, D>() = L_D;
