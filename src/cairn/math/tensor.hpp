@@ -31,30 +31,28 @@ inline const double small_limit = threshold[7];
 /// exp(A) for |A|_inf = b <= small_limit: the degree-m Taylor polynomial, m from the table
 /// above (no data-dependent loop), evaluated Paterson-Stockmeyer style on A^2 and A^3 so that
 /// degree 4 costs 2 matrix products, degree 6 three, degree 7 four (the plain series needs m - 1).
-template <int N>
-[[gnu::always_inline]] inline Eigen::Matrix<double, N, N> exp_small(const Eigen::Matrix<double, N, N>& A, double b) {
-  using M = Eigen::Matrix<double, N, N>;
+/// M is an Eigen matrix or Scalar3 (below); I its identity. M(...) evaluates a product.
+template <class M>
+[[gnu::always_inline]] inline M exp_small(const M& A, const M& I, double b) {
   int m = 1;
   for (int k = 1; k < 7; ++k) m += b > threshold[k];  // branch-free: m = 1 .. 7
-  const M I = M::Identity();
   if (m == 1) return I + A;
-  const M A2 = (A * A).eval();
+  const M A2 = M(A * A);
   switch (m) {
     case 2:
       return I + A + 0.5 * A2;
     case 3:
-      return I + A + (A2 * (0.5 * I + (1.0 / 6) * A)).eval();
+      return I + A + M(A2 * (0.5 * I + (1.0 / 6) * A));
     case 4:
-      return I + A + (A2 * (0.5 * I + (1.0 / 6) * A + (1.0 / 24) * A2)).eval();
+      return I + A + M(A2 * (0.5 * I + (1.0 / 6) * A + (1.0 / 24) * A2));
     default: {
-      const M A3 = (A2 * A).eval();
+      const M A3 = M(A2 * A);
       const M head = I + A + 0.5 * A2;
-      if (m == 5) return head + (A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2)).eval();
-      if (m == 6)
-        return head + (A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2 + (1.0 / 720) * A3)).eval();
-      const M A4 = (A2 * A2).eval();
+      if (m == 5) return head + M(A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2));
+      if (m == 6) return head + M(A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2 + (1.0 / 720) * A3));
+      const M A4 = M(A2 * A2);
       return head + (1.0 / 6) * A3 +
-             (A4 * ((1.0 / 24) * I + (1.0 / 120) * A + (1.0 / 720) * A2 + (1.0 / 5040) * A3)).eval();
+             M(A4 * ((1.0 / 24) * I + (1.0 / 120) * A + (1.0 / 720) * A2 + (1.0 / 5040) * A3));
     }
   }
 }
@@ -105,32 +103,6 @@ struct Scalar3 {
   return r;
 }
 
-/// exp_small for 3x3 on scalars: the same polynomials.
-[[gnu::always_inline]] inline Scalar3 exp_small3(const Scalar3& A, double b) {
-  int m = 1;
-  for (int k = 1; k < 7; ++k) m += b > threshold[k];  // branch-free: m = 1 .. 7
-  const Scalar3 I = Scalar3::identity();
-  if (m == 1) return I + A;
-  const Scalar3 A2 = A * A;
-  switch (m) {
-    case 2:
-      return I + A + 0.5 * A2;
-    case 3:
-      return I + A + A2 * (0.5 * I + (1.0 / 6) * A);
-    case 4:
-      return I + A + A2 * (0.5 * I + (1.0 / 6) * A + (1.0 / 24) * A2);
-    default: {
-      const Scalar3 A3 = A2 * A;
-      const Scalar3 head = I + A + 0.5 * A2;
-      if (m == 5) return head + A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2);
-      if (m == 6) return head + A3 * ((1.0 / 6) * I + (1.0 / 24) * A + (1.0 / 120) * A2 + (1.0 / 720) * A3);
-      const Scalar3 A4 = A2 * A2;
-      return head + (1.0 / 6) * A3 +
-             A4 * ((1.0 / 24) * I + (1.0 / 120) * A + (1.0 / 720) * A2 + (1.0 / 5040) * A3);
-    }
-  }
-}
-
 /// Scaling and squaring for |A|_inf = norm > small_limit (see tensor_exp), out of line.
 template <int N>
 [[gnu::noinline]] Eigen::Matrix<double, N, N> exp_large(const Eigen::Matrix<double, N, N>& a, double norm) {
@@ -170,7 +142,7 @@ template <int N>
     for (double& x : nan.v) x = std::numeric_limits<double>::quiet_NaN();
     return nan;
   }
-  if (norm <= exp_detail::small_limit) return exp_detail::exp_small3(s, norm);
+  if (norm <= exp_detail::small_limit) return exp_detail::exp_small(s, exp_detail::Scalar3::identity(), norm);
   return exp_detail::Scalar3::of(exp_detail::exp_large<3>(a, norm));
 }
 
@@ -197,7 +169,7 @@ template <int N>
   } else {
     const double norm = a.cwiseAbs().rowwise().sum().maxCoeff();  // infinity norm
     if (!std::isfinite(norm)) return M::Constant(std::numeric_limits<double>::quiet_NaN());
-    if (norm <= exp_detail::small_limit) return exp_detail::exp_small<N>(a, norm);
+    if (norm <= exp_detail::small_limit) return exp_detail::exp_small<M>(a, M::Identity(), norm);
     return exp_detail::exp_large<N>(a, norm);
   }
 }

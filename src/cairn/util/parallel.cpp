@@ -17,9 +17,10 @@ std::uint64_t pack(std::int64_t front, std::int64_t back) {
 }  // namespace
 
 StealingShare::StealingShare(std::int64_t n) : n_(n), team_(omp_get_max_threads()) {
-  if (team_ < 2 || n >= (std::int64_t{1} << 32)) return;  // serial, or a range too long to pack
+  // Serial, a team beyond the slots, or a range too long to pack: static ranges.
+  stealing_ = team_ >= 2 && team_ <= max_team && n < (std::int64_t{1} << 32);
+  if (!stealing_) return;
   chunk_ = std::clamp<std::int64_t>(n / (team_ * chunks_per_thread), 16, 1024);
-  slots_ = std::vector<Slot>(static_cast<std::size_t>(team_));
   for (int t = 0; t < team_; ++t) {
     const auto [first, last] = static_range(n, t, team_);
     slots_[t].range.store(pack(first, last), std::memory_order_relaxed);
@@ -30,7 +31,7 @@ StealingShare::Cursor StealingShare::cursor() {
   Cursor c;
   c.t_ = omp_get_thread_num();
   c.T_ = omp_get_num_threads();
-  if (c.T_ == team_ && !slots_.empty()) {
+  if (c.T_ == team_ && stealing_) {
     c.share_ = this;
   } else {
     std::tie(c.first_, c.last_) = static_range(n_, c.t_, c.T_);

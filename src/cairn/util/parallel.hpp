@@ -2,10 +2,10 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <utility>
-#include <vector>
 
 namespace cairn {
 
@@ -60,9 +60,11 @@ inline std::pair<std::int64_t, std::int64_t> static_range(std::int64_t n, int t,
 /// together when one core is slowed (the development VM's cores are, often for seconds;
 /// docs/performance.md, "Threads"). Which thread does an item never changes a result: the loops
 /// that use it work particle by particle and reduce with max, min or exact sums.
-/// Made before the parallel region (for a team of omp_get_max_threads() threads); every thread of
-/// the region takes its cursor(). Out of line (util/parallel.cpp): inlined, its code tipped GCC's
-/// inlining budget in the particle update, which then ran 9 % slower on one thread.
+/// Made before the parallel region (for a team of omp_get_max_threads() threads, at most
+/// max_team; larger teams take plain static ranges); every thread of the region takes its
+/// cursor(). It lives on the caller's stack: a step allocates nothing. Out of line
+/// (util/parallel.cpp): inlined, its code tipped GCC's inlining budget in the particle update,
+/// which then ran 9 % slower on one thread.
 class StealingShare {
  public:
   explicit StealingShare(std::int64_t n);
@@ -92,10 +94,12 @@ class StealingShare {
   /// nothing is left.
   std::pair<std::int64_t, std::int64_t> take(int u, bool front);
 
+  static constexpr int max_team = 64;
   std::int64_t n_;
   int team_;
+  bool stealing_ = false;  // a team of 2 .. max_team and n below 2^32
   std::int64_t chunk_ = 0;
-  std::vector<Slot> slots_;
+  std::array<Slot, max_team> slots_;
 };
 
 }  // namespace cairn
