@@ -5,10 +5,12 @@
 // waiting for a member that lost its core; on an idle machine it runs nearly twice as fast on
 // two cores. Neither can be known before the run, and the load changes during it, so the run
 // loop times its steps: it holds the current choice for a while, then runs a short probe with
-// the other count and keeps whichever was faster per step (a probe of the full team ends after
-// its first step when that is already slower than one thread). The hold grows while the
-// choice stays the same (the probes cost less and less of the run) and shrinks again when it
-// changes.
+// the other count and keeps whichever was faster per step (a probe of the full team ends as
+// soon as its steps so far are slower than one thread's). A switch is checked by the hold that
+// follows it, whose many steps see what a short probe can miss: beside a busy process most team
+// steps run at full speed but every few steps one waits for a neighbour's time slice. The hold
+// grows while the choice stays the same (the probes cost less and less of the run) and shrinks
+// again when it changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
 // changes nothing but the speed.
 #pragma once
@@ -16,7 +18,7 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <array>
+#include <utility>
 
 namespace cairn {
 
@@ -24,10 +26,12 @@ class ThreadTuner {
  public:
   /// Steps of a probe of the full team not timed (its first step moves the particles' data to
   /// the other cores' caches; before_step has woken the threads, untimed; a probe of one thread
-  /// needs no such step), steps timed at the end of a hold and of a probe (their median counts),
-  /// and the hold lengths.
+  /// needs no such step), steps timed in a probe, and the hold lengths. A hold times its last
+  /// hold_window steps, never its first (the step after a change of count): enough steps to see
+  /// a neighbour's time slices, few enough to follow a change of load within one hold.
   static constexpr int warm_steps = 1, timed_steps = 3;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
+  static constexpr long long hold_window = first_hold - 1;
   /// A probe slower than the choice by more than this factor confirms the choice beyond the
   /// noise of a few steps: the hold then grows by sure_growth instead of hold_growth, so that
   /// the probes of a clear winner cost less (docs/performance.md, "Threads").
@@ -40,7 +44,7 @@ class ThreadTuner {
   /// max_threads: the team size the run was given; tuning is off for 1 thread or !enabled.
   ThreadTuner(int max_threads, bool enabled) : max_(max_threads), enabled_(enabled && max_threads > 1) {
     chosen_ = current_ = max_;
-    hold_ = warm_steps + timed_steps;  // the first hold only measures the full team
+    hold_ = first_hold;
   }
 
   [[nodiscard]] bool enabled() const { return enabled_; }
@@ -70,31 +74,22 @@ class ThreadTuner {
     ++steps_;
     if (current_ == 1) ++single_steps_;
     ++in_phase_;
-    if (probing_ && current_ != 1 && in_phase_ == warm_steps && seconds > chosen_time_) {
-      // The full team's first step (its threads woken beforehand, untimed) is already slower
-      // than the choice: a busy machine. The probe ends here; its timed steps would cost the
-      // most exactly then (docs/performance.md, "Threads").
-      end_probe(seconds);
-      return;
-    }
-    const long long length = probing_ ? probe_length() : hold_;
-    if (in_phase_ > length - timed_steps) timed_[n_timed_++] = seconds;
-    if (in_phase_ < length) return;
-    const double per_step = median_timed();
-    in_phase_ = 0;
-    n_timed_ = 0;
-    if (!probing_) {
-      // End of a hold: time per step of the choice, then a probe of the other count.
-      chosen_time_ = per_step;
-      if (chosen_ == max_ && per_step > long_step) {
-        hold_ = longest_hold;
+    if (probing_) {
+      probe_seconds_ += seconds;
+      if (current_ != 1 && probe_seconds_ > static_cast<double>(in_phase_) * chosen_time_) {
+        // The team's steps so far (its threads woken beforehand, untimed) are already slower
+        // than the choice: a busy machine, where a team step now and then waits a neighbour's
+        // time slice for one of its threads. The probe ends here; its further steps would cost
+        // the most exactly then (docs/performance.md, "Threads").
+        end_probe(probe_seconds_ / static_cast<double>(in_phase_));
         return;
       }
-      current_ = chosen_ == 1 ? max_ : 1;
-      probing_ = true;
+      if (in_phase_ > probe_length() - timed_steps) window_.add(seconds);
+      if (in_phase_ == probe_length()) end_probe(window_.mean());
       return;
     }
-    end_probe(per_step);
+    if (in_phase_ > hold_ - hold_window) window_.add(seconds);
+    if (in_phase_ == hold_) end_hold(window_.mean());
   }
 
   /// Gives OpenMP back the full team (for what runs after the loop).
@@ -103,19 +98,74 @@ class ThreadTuner {
   }
 
  private:
-  /// Ends the probe now running, whose steps took per_step each: keeps the faster count.
+  /// Step times of a phase: their mean without the slowest step. A pause of the virtual machine
+  /// in one step does not decide, while the steps of a team that wait for a neighbour's time
+  /// slices now and then (missed by a median) count in every window long enough to see two.
+  struct Window {
+    double sum = 0.0, slowest = 0.0;
+    long long n = 0;
+    void add(double t) {
+      sum += t;
+      slowest = std::max(slowest, t);
+      ++n;
+    }
+    [[nodiscard]] double mean() const {
+      return n > 1 ? (sum - slowest) / static_cast<double>(n - 1) : sum;
+    }
+  };
+
+  /// Ends the hold of the choice, whose steps took per_step each.
+  void end_hold(double per_step) {
+    start_phase();
+    chosen_time_ = per_step;
+    if (verifying_) {
+      verifying_ = false;
+      if (per_step > other_time_) {
+        // The hold after a switch is slower than the count before it: the probe that won was
+        // lucky (a few team steps between a neighbour's time slices). Back to the count before,
+        // as if the probe had lost.
+        std::swap(chosen_time_, other_time_);
+        chosen_ = current_ = (chosen_ == 1 ? max_ : 1);
+        hold_ = grown(previous_hold_, other_time_);
+        return;
+      }
+    }
+    if (chosen_ == max_ && per_step > long_step) {
+      hold_ = longest_hold;
+      return;
+    }
+    current_ = chosen_ == 1 ? max_ : 1;
+    probing_ = true;
+  }
+
+  /// Ends the probe now running, whose steps took per_step each: keeps the faster count. A
+  /// switch is verified by the hold that follows it (end_hold).
   void end_probe(double per_step) {
-    in_phase_ = 0;
-    n_timed_ = 0;
+    start_phase();
     probing_ = false;
     if (per_step < chosen_time_) {
+      other_time_ = chosen_time_;
       chosen_ = current_;
+      previous_hold_ = hold_;
       hold_ = first_hold;
+      verifying_ = true;
     } else {
-      const long long growth = per_step > sure_margin * chosen_time_ ? sure_growth : hold_growth;
-      hold_ = std::min(longest_hold, std::max(first_hold, hold_ * growth));
+      other_time_ = per_step;
+      hold_ = grown(hold_, per_step);
     }
     current_ = chosen_;
+  }
+
+  /// The next hold of a choice confirmed against a count whose steps took loser_time each.
+  [[nodiscard]] long long grown(long long hold, double loser_time) const {
+    const long long growth = loser_time > sure_margin * chosen_time_ ? sure_growth : hold_growth;
+    return std::min(longest_hold, std::max(first_hold, hold * growth));
+  }
+
+  void start_phase() {
+    in_phase_ = 0;
+    window_ = {};
+    probe_seconds_ = 0.0;
   }
 
   /// Steps of the probe now running (current_ is the probed count).
@@ -126,18 +176,12 @@ class ThreadTuner {
   int chosen_ = 1, current_ = 1;
   int woken_ = 0;  ///< the thread count before_step last set
   bool probing_ = false;
-  long long hold_ = 1, in_phase_ = 0;
-  /// The median of the timed steps of the phase: a pause of the virtual machine in one step
-  /// does not decide, nor does one lucky step of a team beside a busy neighbour.
-  [[nodiscard]] double median_timed() const {
-    static_assert(timed_steps == 3, "the median below is of three steps");
-    const auto& t = timed_;
-    return std::max(std::min(t[0], t[1]), std::min(std::max(t[0], t[1]), t[2]));
-  }
-
-  std::array<double, timed_steps> timed_{};
-  int n_timed_ = 0;
-  double chosen_time_ = 0.0;
+  bool verifying_ = false;  ///< this hold follows a switch: it may undo it
+  long long hold_ = 1, previous_hold_ = 1, in_phase_ = 0;
+  Window window_;
+  double probe_seconds_ = 0.0;  ///< all of a probe's steps so far, warm ones included
+  double chosen_time_ = 0.0;    ///< seconds per step of the choice, at the end of its last hold
+  double other_time_ = 0.0;     ///< seconds per step of the other count, when last measured
   long long steps_ = 0, single_steps_ = 0;
 };
 
