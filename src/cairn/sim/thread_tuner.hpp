@@ -28,14 +28,20 @@ class ThreadTuner {
   /// the other cores' caches; before_step has woken the threads, untimed; a probe of one thread
   /// needs no such step), steps timed in a probe, and the hold lengths. A hold times its last
   /// hold_window steps, never its first (the step after a change of count): enough steps to see
-  /// a neighbour's time slices, few enough to follow a change of load within one hold.
+  /// a neighbour's time slices, few enough to follow a change of load within one hold. The run
+  /// starts with a short measure of the team (warm + timed steps) and a probe of one thread; the
+  /// hold of whichever was faster then checks that first choice as it checks every switch.
   static constexpr int warm_steps = 1, timed_steps = 3;
   static constexpr long long first_hold = 16, longest_hold = 1024, hold_growth = 4;
   static constexpr long long hold_window = first_hold - 1;
   /// A probe slower than the choice by more than this factor confirms the choice beyond the
   /// noise of a few steps: the hold then grows by sure_growth instead of hold_growth, so that
-  /// the probes of a clear winner cost less (docs/performance.md, "Threads").
-  static constexpr double sure_margin = 1.25;
+  /// the probes of a clear winner cost less (docs/performance.md, "Threads"). A team's step
+  /// times are heavy-tailed beside a busy process (most at idle speed, some waiting a time
+  /// slice), so a few lucky team steps can look like a clear win: the team's margin is wider,
+  /// and a probe of the team that ended early (its first steps were slower) grows the hold of
+  /// one thread by hold_growth only.
+  static constexpr double sure_margin = 1.25, sure_margin_team = 1.6;
   static constexpr long long sure_growth = 16;
   /// A step of the full team that takes longer than this is not probed with one thread: its
   /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
@@ -44,7 +50,7 @@ class ThreadTuner {
   /// max_threads: the team size the run was given; tuning is off for 1 thread or !enabled.
   ThreadTuner(int max_threads, bool enabled) : max_(max_threads), enabled_(enabled && max_threads > 1) {
     chosen_ = current_ = max_;
-    hold_ = first_hold;
+    hold_ = warm_steps + timed_steps;  // the first measure of the team
   }
 
   [[nodiscard]] bool enabled() const { return enabled_; }
@@ -81,15 +87,21 @@ class ThreadTuner {
         // than the choice: a busy machine, where a team step now and then waits a neighbour's
         // time slice for one of its threads. The probe ends here; its further steps would cost
         // the most exactly then (docs/performance.md, "Threads").
+        ended_early_ = true;
         end_probe(probe_seconds_ / static_cast<double>(in_phase_));
         return;
       }
-      if (in_phase_ > probe_length() - timed_steps) window_.add(seconds);
-      if (in_phase_ == probe_length()) end_probe(window_.mean());
+      if (in_phase_ > probe_length() - timed_steps) recent_.add(seconds);
+      if (in_phase_ == probe_length()) end_probe(recent_.mean());
       return;
     }
-    if (in_phase_ > hold_ - hold_window) window_.add(seconds);
-    if (in_phase_ == hold_) end_hold(window_.mean());
+    if (in_phase_ > 1) {
+      whole_.add(seconds);
+      if (in_phase_ > hold_ - hold_window) recent_.add(seconds);
+    }
+    // The slower of the whole hold (every neighbour's time slice in it) and its last steps (a
+    // change of load during the hold).
+    if (in_phase_ == hold_) end_hold(std::max(whole_.mean(), recent_.mean()));
   }
 
   /// Gives OpenMP back the full team (for what runs after the loop).
@@ -98,9 +110,11 @@ class ThreadTuner {
   }
 
  private:
-  /// Step times of a phase: their mean without the slowest step. A pause of the virtual machine
-  /// in one step does not decide, while the steps of a team that wait for a neighbour's time
-  /// slices now and then (missed by a median) count in every window long enough to see two.
+  /// Step times of a phase and their mean; in a window of a few steps (a probe, the first
+  /// measure) without the slowest step, so that a pause of the virtual machine in one step does
+  /// not decide. A longer window keeps every step: the team steps that wait for a neighbour's
+  /// time slice, one in a few beside a busy process, are what its mean must see (a median of a
+  /// few steps misses them), and one pause weighs little there.
   struct Window {
     double sum = 0.0, slowest = 0.0;
     long long n = 0;
@@ -110,7 +124,8 @@ class ThreadTuner {
       ++n;
     }
     [[nodiscard]] double mean() const {
-      return n > 1 ? (sum - slowest) / static_cast<double>(n - 1) : sum;
+      if (n <= 1) return sum;
+      return n <= timed_steps ? (sum - slowest) / static_cast<double>(n - 1) : sum / static_cast<double>(n);
     }
   };
 
@@ -136,6 +151,7 @@ class ThreadTuner {
     }
     current_ = chosen_ == 1 ? max_ : 1;
     probing_ = true;
+    ended_early_ = false;
   }
 
   /// Ends the probe now running, whose steps took per_step each: keeps the faster count. A
@@ -143,6 +159,19 @@ class ThreadTuner {
   void end_probe(double per_step) {
     start_phase();
     probing_ = false;
+    if (first_probe_) {
+      // The first choice stands on a few steps of each count: its hold checks it.
+      first_probe_ = false;
+      other_time_ = std::max(per_step, chosen_time_);
+      if (per_step < chosen_time_) {
+        chosen_time_ = per_step;
+        chosen_ = current_;
+      }
+      current_ = chosen_;
+      previous_hold_ = hold_ = first_hold;
+      verifying_ = true;
+      return;
+    }
     if (per_step < chosen_time_) {
       other_time_ = chosen_time_;
       chosen_ = current_;
@@ -158,13 +187,15 @@ class ThreadTuner {
 
   /// The next hold of a choice confirmed against a count whose steps took loser_time each.
   [[nodiscard]] long long grown(long long hold, double loser_time) const {
-    const long long growth = loser_time > sure_margin * chosen_time_ ? sure_growth : hold_growth;
+    const double margin = chosen_ == 1 ? sure_margin : sure_margin_team;
+    const bool sure = !ended_early_ && loser_time > margin * chosen_time_;
+    const long long growth = sure ? sure_growth : hold_growth;
     return std::min(longest_hold, std::max(first_hold, hold * growth));
   }
 
   void start_phase() {
     in_phase_ = 0;
-    window_ = {};
+    whole_ = recent_ = {};
     probe_seconds_ = 0.0;
   }
 
@@ -176,10 +207,12 @@ class ThreadTuner {
   int chosen_ = 1, current_ = 1;
   int woken_ = 0;  ///< the thread count before_step last set
   bool probing_ = false;
-  bool verifying_ = false;  ///< this hold follows a switch: it may undo it
+  bool verifying_ = false;   ///< this hold follows a switch (or the first probe): it may undo it
+  bool first_probe_ = true;  ///< the probe now running or next is the run's first
   long long hold_ = 1, previous_hold_ = 1, in_phase_ = 0;
-  Window window_;
+  Window whole_, recent_;  ///< a hold's steps but its first, and its (or a probe's) last ones
   double probe_seconds_ = 0.0;  ///< all of a probe's steps so far, warm ones included
+  bool ended_early_ = false;    ///< the probe that just ended was a team's, ended early
   double chosen_time_ = 0.0;    ///< seconds per step of the choice, at the end of its last hold
   double other_time_ = 0.0;     ///< seconds per step of the other count, when last measured
   long long steps_ = 0, single_steps_ = 0;
