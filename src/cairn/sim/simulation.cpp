@@ -94,7 +94,10 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     create_particles<D>(config_, grid_, materials_, mode_, particles_);
   }
   particles_.shrink_to_fit();
-  for (const auto& m : materials_) material_density_.push_back(m->density());
+  for (const auto& m : materials_) {
+    material_density_.push_back(m->density());
+    wave_speed_varies_.push_back(m->wave_speed_varies() ? 1 : 0);
+  }
   material_in_use_.assign(materials_.size(), 0);
   for (std::int32_t m : particles_.material) material_in_use_[m] = 1;
   if (comm.parallel()) {
@@ -444,11 +447,9 @@ double Simulation<D>::max_signal_speed() const {
   const auto n = static_cast<std::int64_t>(n_owned());
   const auto n_materials = static_cast<std::int32_t>(materials_.size());
   double c_max = 0.0;
-  std::vector<char> varies(materials_.size(), 0);
-  for (std::int32_t m = 0; m < n_materials; ++m) {
-    varies[m] = materials_[m]->wave_speed_varies();
+  const char* varies = wave_speed_varies_.data();  // set up once, not per step
+  for (std::int32_t m = 0; m < n_materials; ++m)
     if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
-  }
   double v2_max = 0.0;
 #pragma omp parallel reduction(max : c_max, v2_max) if (n >= particle_loop_min)
   {

@@ -258,6 +258,7 @@ class Simulation {
   std::unique_ptr<Conduction<D>> conduction_;  ///< [thermal] conduction = true
   std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
   std::vector<char> material_in_use_;     ///< whether any particle has material m
+  std::vector<char> wave_speed_varies_;   ///< Material::wave_speed_varies of material m
   enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion

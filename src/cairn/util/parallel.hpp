@@ -62,7 +62,7 @@ inline std::pair<std::int64_t, std::int64_t> static_range(std::int64_t n, int t,
 /// that use it work particle by particle and reduce with max, min or exact sums.
 /// Made before the parallel region (for a team of omp_get_max_threads() threads, at most
 /// max_team; larger teams take plain static ranges); every thread of the region takes its
-/// cursor(). It lives on the caller's stack: a step allocates nothing. Out of line
+/// cursor(). It lives on the caller's stack: a loop allocates nothing. Out of line
 /// (util/parallel.cpp): inlined, its code tipped GCC's inlining budget in the particle update,
 /// which then ran 9 % slower on one thread.
 class StealingShare {
