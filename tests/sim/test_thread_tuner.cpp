@@ -55,9 +55,9 @@ TEST(ThreadTuner, OnePausedStepDoesNotDecide) {
   for (int s = 0; s < first; ++s) tuner.after_step(s == first - 1 ? 15e-3 : 0.5e-3);
   drive(tuner, 200, 0.5e-3, 1e-3);
   EXPECT_EQ(tuner.threads(), 2);
-  // Two probes in 204 steps: after the first measure and after the hold of 16 that checks it
-  // (then a hold of 256: one thread is 2x slower).
-  EXPECT_EQ(tuner.single_thread_steps(), 2 * ThreadTuner::timed_steps);
+  // One probe in 204 steps: after the first measure; the team's hold of 16 that checks the
+  // choice grows to 256 (one thread is 2x slower).
+  EXPECT_EQ(tuner.single_thread_steps(), ThreadTuner::timed_steps);
 }
 
 TEST(ThreadTuner, SeesTheNeighboursTimeSlicesInTheTeamsSteps) {
@@ -100,17 +100,19 @@ TEST(ThreadTuner, KeepsTheTeamWhenItIsFasterAndProbesLessOften) {
   const long long single = drive(tuner, 4000, 0.9e-3, 1e-3);
   EXPECT_EQ(tuner.threads(), 2);
   // Probes of one thread (timed steps only, no warm step) after the first measure (4 steps)
-  // and holds of 16, 64, 256, 1024, 1024 and 1024 steps.
-  EXPECT_EQ(single, 7 * ThreadTuner::timed_steps);
+  // and holds of 64 (the hold of 16 that checks the first choice grows into it), 256, 1024,
+  // 1024 and 1024 steps.
+  EXPECT_EQ(single, 6 * ThreadTuner::timed_steps);
 }
 
 TEST(ThreadTuner, AClearWinnerIsProbedLessOften) {
-  // One thread 2x slower, beyond sure_margin: the hold grows 16x (16, 256, then 1024), 6
-  // probes in 4000 steps (the first after the first measure of 4 steps).
+  // One thread 2x slower, beyond sure_margin_team: the hold grows 16x (the hold of 16 that
+  // checks the first choice into 256, then 1024), 5 probes in 4000 steps (the first after the
+  // first measure of 4 steps).
   ThreadTuner tuner(2, true);
   const long long single = drive(tuner, 4000, 0.5e-3, 1e-3);
   EXPECT_EQ(tuner.threads(), 2);
-  EXPECT_EQ(single, 6 * ThreadTuner::timed_steps);
+  EXPECT_EQ(single, 5 * ThreadTuner::timed_steps);
 }
 
 TEST(ThreadTuner, FollowsAChangeOfLoad) {

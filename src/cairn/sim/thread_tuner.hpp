@@ -8,7 +8,8 @@
 // the other count and keeps whichever was faster per step (a probe of the full team ends as
 // soon as its steps so far are slower than one thread's). A switch is checked by the hold that
 // follows it, whose many steps see what a short probe can miss: beside a busy process most team
-// steps run at full speed but every few steps one waits for a neighbour's time slice. The hold
+// steps run at full speed but every few steps one waits for a neighbour's time slice (a team so
+// confirmed needs no probe of one thread right after). The hold
 // grows while the choice stays the same (the probes cost less and less of the run) and shrinks
 // again when it changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
@@ -142,6 +143,14 @@ class ThreadTuner {
         std::swap(chosen_time_, other_time_);
         chosen_ = current_ = (chosen_ == 1 ? max_ : 1);
         hold_ = grown(previous_hold_, other_time_);
+        return;
+      }
+      if (chosen_ == max_) {
+        // The team confirmed against one thread, whose steady steps were timed just before the
+        // switch: a probe now would time them again; the hold grows as after a lost probe. (A
+        // confirmed single thread still probes the team: the team's earlier time may be a
+        // passing state, such as both threads on one core at the start of the run.)
+        hold_ = grown(hold_, other_time_);
         return;
       }
     }
