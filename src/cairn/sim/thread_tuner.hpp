@@ -9,9 +9,8 @@
 // soon as its steps so far are slower than one thread's). A switch is checked by the hold that
 // follows it, whose many steps see what a short probe can miss: beside a busy process most team
 // steps run at full speed but every few steps one waits for a neighbour's time slice (a team so
-// confirmed needs no probe of one thread right after). The hold
-// grows while the choice stays the same (the probes cost less and less of the run) and shrinks
-// again when it changes.
+// confirmed needs no probe of one thread right after). The hold grows while the choice stays
+// the same (the probes cost less and less of the run) and shrinks again when it changes.
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
 // changes nothing but the speed.
 #pragma once
