@@ -26,9 +26,10 @@ class ThreadTuner {
  public:
   /// Steps of a probe of the full team not timed (its first step moves the particles' data to
   /// the other cores' caches; before_step has woken the threads, untimed; a probe of one thread
-  /// needs no such step), steps timed in a probe, and the hold lengths. A hold times its last
-  /// hold_window steps, never its first (the step after a change of count): enough steps to see
-  /// a neighbour's time slices, few enough to follow a change of load within one hold. The run
+  /// needs no such step), steps timed in a probe, and the hold lengths. A hold's time is the
+  /// slower of the mean of its steps but the first (the step after a change of count) and the
+  /// mean of its last hold_window steps: enough steps to see a neighbour's time slices, few
+  /// enough to follow a change of load within one hold. The run
   /// starts with a short measure of the team (warm + timed steps) and a probe of one thread; the
   /// hold of whichever was faster then checks that first choice as it checks every switch.
   static constexpr int warm_steps = 1, timed_steps = 3;
