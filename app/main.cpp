@@ -8,12 +8,14 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <omp.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <iostream>
 #include <new>
 #include <sstream>
+#include <vector>
 
 #include "cairn/fem/solver.hpp"
 #include "cairn/io/errors.hpp"
@@ -104,6 +106,26 @@ void print_warnings(const cairn::Config& config) {
   for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
 }
 
+/// With OMP_PROC_BIND set, libgomp binds the initial thread to the first place when it loads,
+/// and the restart below would inherit that one place as the whole process's affinity: every
+/// thread of the restarted process on one core (`OMP_PROC_BIND=close OMP_PLACES=cores` ran -t 2
+/// at 0.9x one thread). Before the restart the thread gets back every processor of the places
+/// the runtime built from the affinity it was started with, so the restarted runtime builds the
+/// same places.
+void release_initial_binding() {
+  const int n_places = omp_get_num_places();
+  if (n_places <= 0) return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int place = 0; place < n_places; ++place) {
+    std::vector<int> ids(static_cast<std::size_t>(omp_get_place_num_procs(place)));
+    omp_get_place_proc_ids(place, ids.data());
+    for (const int id : ids)
+      if (id >= 0 && id < CPU_SETSIZE) CPU_SET(id, &set);
+  }
+  if (CPU_COUNT(&set) > 0) ::sched_setaffinity(0, sizeof(set), &set);
+}
+
 /// Largest -t: as simulation.threads (io/schema.cpp).
 constexpr int max_threads = 1024;
 
@@ -120,6 +142,7 @@ int main(int argc, char** argv) {
   // before MPI is initialised.
   if (std::getenv("OMP_WAIT_POLICY") == nullptr && std::getenv("GOMP_SPINCOUNT") == nullptr) {
     ::setenv("GOMP_SPINCOUNT", "1000", 1);
+    release_initial_binding();
     ::execv("/proc/self/exe", argv);  // returns only on failure: go on with the runtime's default
   }
   // Under mpirun/srun every rank runs this program (docs/parallel.md); rank 0 alone prints.

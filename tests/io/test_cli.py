@@ -230,6 +230,34 @@ def orphan_temporaries(cairn, tmp):
     check(os.path.exists(alive), "a temporary of a live process is kept")
 
 
+def thread_binding(cairn, tmp):
+    # cairn restarts itself once to set its OpenMP spin (app/main.cpp). With OMP_PROC_BIND set,
+    # libgomp has bound the first process's thread to one place by then; the restarted process
+    # must still see every place, so that its threads run on different processors.
+    cpus = sorted(os.sched_getaffinity(0))
+    if len(cpus) < 2:
+        print("  (one processor here: thread binding not checked)")
+        return
+    case = write_case(os.path.join(tmp, "bind", "case.toml"), end_time=1.0e-6, every=1.0e-6)
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "OMP_NUM_THREADS")}
+    for bind, places in (("spread", "threads"), ("close", "cores"), ("true", None)):
+        env_b = dict(env, OMP_PROC_BIND=bind, OMP_DISPLAY_AFFINITY="TRUE",
+                     OMP_AFFINITY_FORMAT="cairn-affinity %n %A")
+        if places:
+            env_b["OMP_PLACES"] = places
+        proc = subprocess.run([cairn, "run", case, "-q", "-t", "2", "--set", "simulation.adapt_threads=false"],
+                              capture_output=True, text=True, timeout=600, env=env_b)
+        check(proc.returncode == 0, f"OMP_PROC_BIND={bind} OMP_PLACES={places}: the run succeeds")
+        bound = {}
+        for line in (proc.stdout + proc.stderr).splitlines():
+            fields = line.split()
+            if len(fields) == 3 and fields[0] == "cairn-affinity":
+                bound[fields[1]] = fields[2]
+        check(len(bound) == 2 and len(set(bound.values())) == 2,
+              f"OMP_PROC_BIND={bind} OMP_PLACES={places}: the 2 threads are bound to different processors "
+              f"({bound})")
+
+
 def main():
     if len(sys.argv) < 3:
         print("usage: test_cli.py <cairn binary> <source dir>", file=sys.stderr)
@@ -238,7 +266,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="cairn_cli_") as tmp:
         try:
             for case in (usage_and_exit_codes, gmsh_loaded_on_demand, progress_bar, interrupts, wall_clock_checkpoints,
-                         relative_folders_and_restarts, orphan_temporaries):
+                         relative_folders_and_restarts, orphan_temporaries, thread_binding):
                 print(case.__name__)
                 case(cairn, tmp)
         except (CheckFailed, subprocess.TimeoutExpired) as e:
