@@ -10,7 +10,7 @@ other guests, which marks the slow periods of a virtual machine.
 
   /usr/bin/python3 bench/thread_scaling.py [--cairn build/release/cairn] [--problems a d]
       [--pairs 3] [--settings default PASSIVE spin=1000 fixed:spin=1000] [--steps-scale 1]
-      [--only alone|busy] [--quiet-check] [--quiet-rounds]
+      [--only alone|busy] [--quiet-check] [--quiet-rounds] [--ceiling]
 
 A setting is the OpenMP wait policy of the 2-thread run: "default" leaves OMP_WAIT_POLICY and
 GOMP_SPINCOUNT unset (what a user gets: cairn picks its own default, app/main.cpp), PASSIVE or
@@ -23,6 +23,14 @@ before every round alone and prints a second table over the quiet rounds only: t
 slower copy ran at 0.92 or more of the fastest copy of the block. On a virtual machine a core
 slows for minutes at a time (docs/performance.md, "Threads"); a round in those minutes does not
 measure an idle machine. Both tables are printed, all rounds first.
+
+--ceiling runs the machine's 2-thread ceiling (cairn_ceiling, bench/ceiling.cpp: a perfectly
+parallel compute loop on private in-cache data, barriers at a step's cadence) once on 1 thread
+before every round alone and on 2 threads right before and right after the round's runs. Its
+gain, the block's median 1-thread time over the 2-thread time, is what this machine gives any
+program from a second thread at that moment (2.0 on an idle 2-core machine). A third table
+keeps the rounds whose ceiling gain was 1.9 or more both before and after ("machine at its
+ceiling"), and gives every round's gain over the mean of its two ceiling gains.
 """
 import argparse
 import os
@@ -77,12 +85,18 @@ def main():
                          "(compare_baseline.side_by_side): both near a lone run's rate mark quiet cores")
     ap.add_argument("--quiet-rounds", action="store_true",
                     help="the side-by-side check before every round alone, and a table of the quiet rounds")
+    ap.add_argument("--ceiling", action="store_true",
+                    help="the machine's 2-thread ceiling (cairn_ceiling) around every round alone, and a "
+                         "table of the rounds at the ceiling")
     args = ap.parse_args()
+    ceiling_bin = os.path.join(os.path.dirname(os.path.abspath(args.cairn)), "bench", "cairn_ceiling")
+    if args.ceiling and not os.path.exists(ceiling_bin):
+        sys.exit(f"--ceiling: {ceiling_bin} not found (cmake --build build/release --target cairn_ceiling)")
     scratch = f"/tmp/cairn-threads-{os.getpid()}"
     quiet = args.quiet_check and args.only != "busy"
     if quiet:
         print("before: " + cb.quiet_line(args.cairn, scratch), flush=True)
-    rows, quiet_rows = [], []
+    rows, quiet_rows, ceiling_rows = [], [], []
     for busy in (False, True):
         if args.only and args.only != ("busy" if busy else "alone"):
             continue
@@ -94,7 +108,10 @@ def main():
                 got = {c: [] for c in configs}
                 ratios = {s: [] for s in args.settings}
                 checks = []  # the slower and the faster copy of each round's side-by-side check
+                ceil = []  # each round's ceiling times: 1 thread, 2 threads before, 2 threads after
                 for r in range(args.pairs):
+                    if args.ceiling and not busy:
+                        ceil.append([ceiling_seconds(ceiling_bin, 1), ceiling_seconds(ceiling_bin, 2)])
                     if args.quiet_rounds and not busy:
                         pair = sorted(cb.side_by_side(args.cairn, scratch))
                         checks.append(pair)
@@ -104,6 +121,10 @@ def main():
                     steal = steal_ms()
                     res = {c: run(args.cairn, prob, c[0], c[1], scratch, args.steps_scale) for c in order}
                     steal = steal_ms() - steal
+                    if args.ceiling and not busy:
+                        ceil[-1].append(ceiling_seconds(ceiling_bin, 2))
+                        print(f"  ceiling: 1 thread {ceil[-1][0]:.3f} s, 2 threads {ceil[-1][1]:.3f} s before, "
+                              f"{ceil[-1][2]:.3f} s after", flush=True)
                     for c in configs:
                         got[c].append(res[c])
                     for s in args.settings:
@@ -124,6 +145,18 @@ def main():
                             quiet_rows.append((prob, s, len(keep), len(checks), statistics.median(q), min(q), max(q)))
                         else:
                             quiet_rows.append((prob, s, 0, len(checks), float("nan"), float("nan"), float("nan")))
+                if ceil:
+                    one = statistics.median(c[0] for c in ceil)
+                    gains = [(one / c[1], one / c[2]) for c in ceil]
+                    keep = [r for r, g in enumerate(gains) if min(g) >= 1.9]
+                    for s in args.settings:
+                        at = [ratios[s][r] for r in keep]
+                        rel = [ratios[s][r] / (0.5 * (g[0] + g[1])) for r, g in enumerate(gains)]
+                        ceiling_rows.append((prob, s, len(keep), len(gains),
+                                             statistics.median(at) if at else float("nan"),
+                                             min(at) if at else float("nan"), max(at) if at else float("nan"),
+                                             statistics.median(g for pair in gains for g in pair),
+                                             statistics.median(rel), min(rel), max(rel)))
         finally:
             if neighbour:
                 neighbour.kill()
@@ -142,6 +175,23 @@ def main():
         print("|---|---|---:|---:|")
         for prob, s, k, n, r, lo, hi in quiet_rows:
             print(f"| ({prob}) | {s} | {k} of {n} | {r:.2f} ({lo:.2f}-{hi:.2f}) |")
+    if ceiling_rows:
+        print("\nthe machine's 2-thread ceiling (cairn_ceiling) around each round alone; 'at the ceiling': "
+              "rounds whose ceiling gain was >= 1.9 before and after")
+        print("| problem | 2-thread setting | rounds at the ceiling | 2 / 1 there (min-max) | ceiling gain, "
+              "median | 2 / 1 over the round's ceiling gain (min-max) |")
+        print("|---|---|---:|---:|---:|---:|")
+        for prob, s, k, n, r, lo, hi, g, rel, rlo, rhi in ceiling_rows:
+            print(f"| ({prob}) | {s} | {k} of {n} | {r:.2f} ({lo:.2f}-{hi:.2f}) | {g:.2f} | "
+                  f"{rel:.2f} ({rlo:.2f}-{rhi:.2f}) |")
+
+
+def ceiling_seconds(binary, threads):
+    """Seconds of one cairn_ceiling run (bench/ceiling.cpp) with cairn's own spin setting."""
+    env = dict(os.environ, GOMP_SPINCOUNT="1000")
+    env.pop("OMP_WAIT_POLICY", None)
+    out = subprocess.run([binary, str(threads)], capture_output=True, text=True, check=True, env=env).stdout
+    return float(out.split()[0])
 
 
 if __name__ == "__main__":
