@@ -24,6 +24,7 @@
 #include "cairn/parallel/comm.hpp"
 #include "cairn/sim/run.hpp"
 #include "cairn/sim/simulation.hpp"
+#include "cairn/util/cpu_quota.hpp"
 #include "cairn/util/registry.hpp"
 
 namespace {
@@ -126,6 +127,11 @@ void release_initial_binding() {
   if (CPU_COUNT(&set) > 0) ::sched_setaffinity(0, sizeof(set), &set);
 }
 
+/// -t, for run and restart.
+constexpr const char* threads_help =
+    "OpenMP threads, 0..1024 (0 or absent: OMP_NUM_THREADS, else all cores up to the CPU limit of the "
+    "control group)";
+
 /// Largest -t: as simulation.threads (io/schema.cpp).
 constexpr int max_threads = 1024;
 
@@ -168,7 +174,7 @@ int main(int argc, char** argv) {
   run->add_option("input", input, "input file")->required();
   run->add_option("--set", overrides, "override an input key: section.key=value (repeatable)");
   run->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  run->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+  run->add_option("-t,--threads", threads, threads_help)
       ->check(CLI::Range(0, max_threads));
 
   auto* check = app.add_subcommand("check", "validate an input file and print the resolved settings");
@@ -182,7 +188,7 @@ int main(int argc, char** argv) {
   restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
   restart->add_option("--set", overrides, "override an input key of the stored input");
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
-  restart->add_option("-t,--threads", threads, "OpenMP threads, 0..1024 (0 or absent: the OpenMP default, all cores)")
+  restart->add_option("-t,--threads", threads, threads_help)
       ->check(CLI::Range(0, max_threads));
 
   try {
@@ -213,6 +219,19 @@ int main(int argc, char** argv) {
     omp_set_num_threads(threads);
     // The command line wins over the input file's simulation.threads (docs/robustness.md).
     overrides.push_back(fmt::format("simulation.threads={}", threads));
+  } else if (std::getenv("OMP_NUM_THREADS") == nullptr) {
+    // Without a thread count from the user, no more threads than the CPU time the control groups
+    // allow (a container's CPU limit; util/cpu_quota.hpp). simulation.threads still wins.
+    if (const auto cpus = cairn::cgroup_cpu_limit()) {
+      const int seen = omp_get_max_threads(), allowed = cairn::threads_for_cpu_limit(*cpus);
+      if (allowed < seen) {
+        omp_set_num_threads(allowed);
+        if (root && !quiet && (*run || *restart))
+          std::cerr << fmt::format("cairn: note: the CPU limit of this process's control group is {:.3g} CPUs of "
+                                   "the {} it sees: {} thread{} (-t or OMP_NUM_THREADS to choose)\n",
+                                   *cpus, seen, allowed, allowed == 1 ? "" : "s");
+      }
+    }
   }
 
   try {

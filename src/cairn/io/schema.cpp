@@ -101,8 +101,9 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("1.0")
                 .min(above_zero));
   k.push_back(Key("simulation", "threads", T::integer,
-                 "OpenMP threads, at most 1024; 0 = the command line's -t, else the OpenMP "
-                 "default (OMP_NUM_THREADS or all cores).")
+                 "OpenMP threads, at most 1024; 0 = the command line's -t, else OMP_NUM_THREADS, "
+                 "else all cores up to the CPU limit of the process's control group (a container's "
+                 "CPU quota).")
                 .by_default("0")
                 .min(0)
                 .max(1024));
