@@ -218,7 +218,7 @@ class Runner {
       write_history_row();
       write_snapshot();
     }
-    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads);
+    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads, &ThreadTuner::runnable_others);
     while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
       tuner.before_step();
       const auto step_start = Clock::now();

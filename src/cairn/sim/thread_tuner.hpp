@@ -10,7 +10,9 @@
 // follows it, whose many steps see what a short probe can miss: beside a busy process most team
 // steps run at full speed but every few steps one waits for a neighbour's time slice (a team so
 // confirmed needs no probe of one thread right after). The hold grows while the choice stays
-// the same (the probes cost less and less of the run) and shrinks again when it changes.
+// the same (the probes cost less and less of the run) and shrinks again when it changes, and
+// a hold of one thread stays short when nothing else on the machine wants a processor (a
+// virtual machine's host can slow a team for a moment without any neighbour in sight).
 // Results do not depend on the thread count (transfer/transfer.hpp), so switching between steps
 // changes nothing but the speed.
 #pragma once
@@ -18,6 +20,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <utility>
 
 namespace cairn {
@@ -47,9 +50,34 @@ class ThreadTuner {
   /// A step of the full team that takes longer than this is not probed with one thread: its
   /// parallel regions are long enough that waiting at barriers costs little (docs/performance.md).
   static constexpr double long_step = 0.02;
+  /// Runnable tasks on the machine other than the caller, or -1 when not known.
+  using OtherTasks = int (*)();
+  /// Steps at the end of a hold of one thread that ask other_tasks, and the longest hold of one
+  /// thread when none of them saw another runnable task: then nothing competes for the cores
+  /// inside the machine, and a team that lost its probes was slowed by something that passes
+  /// (a virtual machine's host running other guests on its processors). Beside a busy process
+  /// the holds grow as before (docs/performance.md, "Threads").
+  static constexpr int alone_samples = 3;
+  static constexpr long long alone_single_hold = 64;
+
+  /// Other runnable tasks from /proc/loadavg (its fourth field counts the runnable tasks, the
+  /// caller included); -1 where it cannot be read. Asked at the end of a hold of one thread,
+  /// when the team's other threads are parked: with a wait policy that keeps them spinning
+  /// (OMP_WAIT_POLICY=ACTIVE) they count as other tasks, and the holds grow as before.
+  static int runnable_others() {
+    std::FILE* f = std::fopen("/proc/loadavg", "r");
+    if (!f) return -1;
+    int running = 0, total = 0;
+    const bool ok = std::fscanf(f, "%*f %*f %*f %d/%d", &running, &total) == 2;
+    std::fclose(f);
+    return ok && running >= 1 ? running - 1 : -1;
+  }
 
   /// max_threads: the team size the run was given; tuning is off for 1 thread or !enabled.
-  ThreadTuner(int max_threads, bool enabled) : max_(max_threads), enabled_(enabled && max_threads > 1) {
+  /// other_tasks: how many other tasks are runnable (runnable_others in a run; null: not
+  /// known, the holds of one thread grow like the team's).
+  ThreadTuner(int max_threads, bool enabled, OtherTasks other_tasks = nullptr)
+      : max_(max_threads), enabled_(enabled && max_threads > 1), other_tasks_(other_tasks) {
     chosen_ = current_ = max_;
     hold_ = warm_steps + timed_steps;  // the first measure of the team
   }
@@ -100,6 +128,10 @@ class ThreadTuner {
       whole_.add(seconds);
       if (in_phase_ > hold_ - hold_window) recent_.add(seconds);
     }
+    if (current_ == 1 && other_tasks_ && in_phase_ > hold_ - alone_samples) {
+      ++asked_;
+      others_seen_ |= other_tasks_() != 0;
+    }
     // The slower of the whole hold (every neighbour's time slice in it) and its last steps (a
     // change of load during the hold).
     if (in_phase_ == hold_) end_hold(std::max(whole_.mean(), recent_.mean()));
@@ -132,6 +164,7 @@ class ThreadTuner {
 
   /// Ends the hold of the choice, whose steps took per_step each.
   void end_hold(double per_step) {
+    if (chosen_ == 1 && other_tasks_) alone_ = asked_ > 0 && !others_seen_;
     start_phase();
     chosen_time_ = per_step;
     if (verifying_) {
@@ -199,13 +232,16 @@ class ThreadTuner {
     const double margin = chosen_ == 1 ? sure_margin : sure_margin_team;
     const bool sure = !ended_early_ && loser_time > margin * chosen_time_;
     const long long growth = sure ? sure_growth : hold_growth;
-    return std::min(longest_hold, std::max(first_hold, hold * growth));
+    const long long cap = chosen_ == 1 && alone_ ? alone_single_hold : longest_hold;
+    return std::min(cap, std::max(first_hold, hold * growth));
   }
 
   void start_phase() {
     in_phase_ = 0;
     whole_ = recent_ = {};
     probe_seconds_ = 0.0;
+    asked_ = 0;
+    others_seen_ = false;
   }
 
   /// Steps of the probe now running (current_ is the probed count).
@@ -225,6 +261,10 @@ class ThreadTuner {
   double chosen_time_ = 0.0;    ///< seconds per step of the choice, at the end of its last hold
   double other_time_ = 0.0;     ///< seconds per step of the other count, when last measured
   long long steps_ = 0, single_steps_ = 0;
+  OtherTasks other_tasks_ = nullptr;
+  int asked_ = 0;             ///< other_tasks asked in this phase
+  bool others_seen_ = false;  ///< ... and one answer was not 0
+  bool alone_ = false;        ///< the last hold of one thread saw no other runnable task
 };
 
 }  // namespace cairn
