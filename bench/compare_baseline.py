@@ -55,7 +55,8 @@ def build_current():
     return os.path.join(ROOT, "build", "release", "cairn")
 
 
-def run_once(binary, problem, threads, scratch, scale, more=()):
+def run_once(binary, problem, threads, scratch, scale, more=(), with_output=False):
+    """Particle-steps/s of one run (and the run's printed output with with_output)."""
     toml, extra = PROBLEMS[problem]
     extra = list(extra) + list(more)
     if scale != 1.0:
@@ -70,7 +71,7 @@ def run_once(binary, problem, threads, scratch, scale, more=()):
     m = SUMMARY.search(res.stdout + res.stderr)
     if not m:
         sys.exit(f"no summary line from {' '.join(cmd)}:\n{res.stdout}\n{res.stderr}")
-    return float(m.group(3))
+    return (float(m.group(3)), res.stdout + res.stderr) if with_output else float(m.group(3))
 
 
 def side_by_side(binary, scratch):

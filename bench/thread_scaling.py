@@ -34,6 +34,7 @@ ceiling"), and gives every round's gain over the mean of its two ceiling gains.
 """
 import argparse
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -56,7 +57,9 @@ def run(binary, problem, threads, setting, scratch, scale):
         os.environ["OMP_WAIT_POLICY"] = policy
     more = ["--set", "simulation.adapt_threads=false"] if fixed else []
     try:
-        return cb.run_once(binary, problem, threads, scratch, scale, more)
+        rate, output = cb.run_once(binary, problem, threads, scratch, scale, more, with_output=True)
+        m = re.search(r"adaptive threads: (\d+) of (\d+) steps on 1 thread", output)
+        return rate, (int(m.group(1)) if m else None)
     finally:
         for k, v in saved.items():
             if v is None:
@@ -119,7 +122,9 @@ def main():
                     k = r % len(configs)
                     order = configs[k:] + configs[:k]
                     steal = steal_ms()
-                    res = {c: run(args.cairn, prob, c[0], c[1], scratch, args.steps_scale) for c in order}
+                    runs = {c: run(args.cairn, prob, c[0], c[1], scratch, args.steps_scale) for c in order}
+                    res = {c: runs[c][0] for c in configs}
+                    single = {c: runs[c][1] for c in configs}
                     steal = steal_ms() - steal
                     if args.ceiling and not busy:
                         ceil[-1].append(ceiling_seconds(ceiling_bin, 2))
@@ -130,7 +135,9 @@ def main():
                     for s in args.settings:
                         ratios[s].append(res[(2, s)] / res[(1, "default")])
                     print(f"  ({prob}) {'busy' if busy else 'alone'} round {r + 1}: 1 thread {res[(1, 'default')]:.3g}; "
-                          + ", ".join(f"{s} {res[(2, s)] / res[(1, 'default')]:.2f}" for s in args.settings)
+                          + ", ".join(f"{s} {res[(2, s)] / res[(1, 'default')]:.2f}"
+                                      + (f" [{single[(2, s)]} steps on 1 thread]" if single[(2, s)] is not None else "")
+                                      for s in args.settings)
                           + f"; steal {steal:.0f} ms", flush=True)
                 for s in args.settings:
                     rows.append((prob, "busy" if busy else "alone", s, statistics.median(got[(1, "default")]),
