@@ -51,13 +51,18 @@ std::optional<double> limit_v1(const fs::path& dir) {
   return *q / *p;
 }
 
+/// best becomes the smaller of best and limit (either may be absent).
+void keep_smaller(std::optional<double>& best, const std::optional<double>& limit) {
+  if (limit) best = best ? std::min(*best, *limit) : *limit;
+}
+
 /// The smallest limit from `mount / group` up to `mount`.
 template <class Limit>
 std::optional<double> smallest_up_to_root(const fs::path& mount, const std::string& group, Limit&& limit) {
   std::optional<double> best;
   fs::path rel = fs::path(group).relative_path();
   for (;;) {
-    if (const auto l = limit(mount / rel)) best = best ? std::min(*best, *l) : *l;
+    keep_smaller(best, limit(mount / rel));
     if (rel.empty()) break;
     rel = rel.parent_path();
   }
@@ -70,9 +75,6 @@ std::optional<double> cgroup_cpu_limit(const fs::path& proc_cgroup, const fs::pa
   std::ifstream in(proc_cgroup);
   if (!in) return std::nullopt;
   std::optional<double> best;
-  const auto take = [&](const std::optional<double>& l) {
-    if (l) best = best ? std::min(*best, *l) : *l;
-  };
   // Lines "ID:CONTROLLERS:PATH": "0::PATH" is the unified (v2) hierarchy; a v1 line whose
   // comma-separated controllers include "cpu" names the group of the CPU controller.
   for (std::string line; std::getline(in, line);) {
@@ -82,7 +84,7 @@ std::optional<double> cgroup_cpu_limit(const fs::path& proc_cgroup, const fs::pa
     const std::string controllers = line.substr(c1 + 1, c2 - c1 - 1), group = line.substr(c2 + 1);
     if (controllers.empty()) {
       if (fs::exists(cgroup_root / "cgroup.controllers"))
-        take(smallest_up_to_root(cgroup_root, group, limit_v2));
+        keep_smaller(best, smallest_up_to_root(cgroup_root, group, limit_v2));
       continue;
     }
     std::vector<std::string> names;
@@ -92,7 +94,7 @@ std::optional<double> cgroup_cpu_limit(const fs::path& proc_cgroup, const fs::pa
     // The v1 CPU hierarchy is mounted as cpu, cpu,cpuacct or cpuacct,cpu (a link to one).
     for (const char* mount : {"cpu", "cpu,cpuacct", "cpuacct,cpu"}) {
       if (!fs::is_directory(cgroup_root / mount)) continue;
-      take(smallest_up_to_root(cgroup_root / mount, group, limit_v1));
+      keep_smaller(best, smallest_up_to_root(cgroup_root / mount, group, limit_v1));
       break;
     }
   }
