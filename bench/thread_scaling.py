@@ -31,9 +31,16 @@ gain, the block's median 1-thread time over the 2-thread time, is what this mach
 program from a second thread at that moment (2.0 on an idle 2-core machine). A third table
 keeps the rounds whose ceiling gain was 1.9 or more both before and after ("machine at its
 ceiling"), and gives every round's gain over the mean of its two ceiling gains.
+
+The main table gives, beside the median of the rounds' 2 / 1 ratios, a 95 % interval for that
+median (bootstrap: the median of as many rounds drawn with replacement, 2000 times): on a shared
+machine one round's ratio moves by tens of percent, and the interval says how many rounds a
+figure such as "never below 1.0" needs (an A/A block, 1 thread against 1 thread, 16 rounds:
+median 1.02).
 """
 import argparse
 import os
+import random
 import re
 import statistics
 import subprocess
@@ -66,6 +73,15 @@ def run(binary, problem, threads, setting, scratch, scale):
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def median_interval(values, draws=2000, seed=1):
+    """95 % bootstrap interval of the median of values: the 2.5th and 97.5th percentiles of the
+    medians of `draws` resamples (with replacement, as many as values; a fixed seed, so a table
+    is reproducible from its rounds)."""
+    rng = random.Random(seed)
+    meds = sorted(statistics.median(rng.choices(values, k=len(values))) for _ in range(draws))
+    return meds[int(0.025 * draws)], meds[int(0.975 * draws) - 1]
 
 
 def steal_ms():
@@ -142,7 +158,7 @@ def main():
                 for s in args.settings:
                     rows.append((prob, "busy" if busy else "alone", s, statistics.median(got[(1, "default")]),
                                  statistics.median(got[(2, s)]), statistics.median(ratios[s]), min(ratios[s]),
-                                 max(ratios[s]), load))
+                                 max(ratios[s]), median_interval(ratios[s]), load))
                 if checks:
                     full = max(c[1] for c in checks)
                     keep = [r for r, c in enumerate(checks) if c[0] >= 0.92 * full]
@@ -172,10 +188,12 @@ def main():
             print("after: " + cb.quiet_line(args.cairn, scratch), flush=True)
     print(f"\nload average {os.getloadavg()[0]:.1f} at end; particle-steps/s, medians of {args.pairs} rounds; "
           "'busy': one CPU-bound process beside the run; load: 1-minute load average at the start of the block")
-    print("| problem | machine | load | 2-thread setting | 1 thread | 2 threads | 2 / 1 (min-max) |")
-    print("|---|---|---:|---|---:|---:|---:|")
-    for prob, busy, s, a, b, r, lo, hi, load in rows:
-        print(f"| ({prob}) | {busy} | {load:.1f} | {s} | {a / 1e6:.2f} M | {b / 1e6:.2f} M | {r:.2f} ({lo:.2f}-{hi:.2f}) |")
+    print("| problem | machine | load | 2-thread setting | 1 thread | 2 threads | 2 / 1 (min-max) "
+          "| 95 % interval of the median |")
+    print("|---|---|---:|---|---:|---:|---:|---:|")
+    for prob, busy, s, a, b, r, lo, hi, (clo, chi), load in rows:
+        print(f"| ({prob}) | {busy} | {load:.1f} | {s} | {a / 1e6:.2f} M | {b / 1e6:.2f} M | {r:.3f} ({lo:.2f}-{hi:.2f}) "
+              f"| {clo:.3f}-{chi:.3f} |")
     if quiet_rows:
         print("\nquiet rounds alone only (the slower side-by-side copy at >= 0.92 of the block's fastest copy):")
         print("| problem | 2-thread setting | quiet rounds | 2 / 1 (min-max) |")
