@@ -39,7 +39,7 @@ Mat3 kirchhoff_from_energy(const Material& m, const Mat3& F) {
 }
 
 TEST(Materials, LinearElasticUniaxialStrainByHand) {
-  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}, "small_strain"));
   Mat3 F = Mat3::Identity();
   F(0, 0) = 1.001;
   const Mat3 sigma = m->kirchhoff(F) / F.determinant();
@@ -108,13 +108,111 @@ TEST(Materials, EveryModelStressIsTheDerivativeOfItsEnergy) {
     EXPECT_NEAR(m->energy_density(Mat3::Identity()), 0.0, 1e-15) << form;
     EXPECT_LT(m->kirchhoff(Mat3::Identity()).norm(), 1e-15) << form;
   }
-  auto le = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  auto corotational = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  EXPECT_LT((corotational->kirchhoff(F) - kirchhoff_from_energy(*corotational, F)).norm(), 1e-7);
+  auto le = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}, "small_strain"));
   Mat3 S = Mat3::Identity();  // symmetric small strain: small-strain law is its energy's derivative
   S(0, 0) = 1.001;
   S(1, 1) = 0.999;
   // dW/dF of the small-strain law is the Cauchy stress itself.
   const Mat3 P = kirchhoff_from_energy(*le, S) * S.transpose().inverse();
   EXPECT_LT((le->kirchhoff(S) / S.determinant() - P).norm(), 1e-8);
+}
+
+Mat3 rotation(const Eigen::Vector3d& axis, double angle) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+TEST(Materials, CorotationalLinearElasticUniaxialStrainByHand) {
+  // F = diag(f, 1, 1): V = F, tau = 2G (B - V) + lambda (tr V - 3) V.
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  const double f = 1.001;
+  Mat3 F = Mat3::Identity();
+  F(0, 0) = f;
+  const Mat3 tau = m->kirchhoff(F);
+  EXPECT_NEAR(tau(0, 0), f * (f - 1.0) * (2.0 + 2 * 3.0), 1e-15);  // = the small-strain tau_xx
+  EXPECT_NEAR(tau(1, 1), 2.0 * (f - 1.0), 1e-15);
+  EXPECT_NEAR(tau(0, 1), 0.0, 1e-18);
+  EXPECT_NEAR(m->energy_density(F), 0.5 * 8.0 * 1e-6, 1e-18);
+}
+
+TEST(Materials, CorotationalLinearElasticIgnoresRotations) {
+  // A rigid rotation gives no stress and no energy, for any angle, in 3D and in the plane; the
+  // small-strain form gives stress of order G (1 - cos theta).
+  const double G = 3.0e9, lambda = 2.0e9;
+  auto m = make_material(config("linear_elastic", {{"lambda", lambda}, {"shear_modulus", G}}));
+  auto small = make_material(config("linear_elastic", {{"lambda", lambda}, {"shear_modulus", G}}, "small_strain"));
+  for (double angle : {0.01, 0.3, 1.5, 3.0, 6.0, 100.0}) {
+    for (const Eigen::Vector3d axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, -2, 0.5)}) {
+      const Mat3 R = rotation(axis, angle);
+      EXPECT_LT(m->kirchhoff(R).norm(), 1e-6 * G) << angle;  // round-off of G (V - I)
+      EXPECT_LT(std::abs(m->energy_density(R)), 1e-12 * G) << angle;
+      if (angle > 0.2) EXPECT_GT(small->kirchhoff(R).norm(), 1e-3 * G) << angle;
+    }
+  }
+}
+
+TEST(Materials, CorotationalLinearElasticIsObjective) {
+  // tau(Q F) = Q tau(F) Q^T for a stretch-and-shear F and rotations Q about any axis.
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  const Mat3 F = sample_F(), tau = m->kirchhoff(F);
+  for (double angle : {0.2, 2.0, 4.0}) {
+    const Mat3 Q = rotation(Eigen::Vector3d(0.3, 1.0, -0.7), angle);
+    EXPECT_LT((m->kirchhoff(Q * F) - Q * tau * Q.transpose()).norm(), 1e-13) << angle;
+    EXPECT_NEAR(m->energy_density(Q * F), m->energy_density(F), 1e-15) << angle;
+  }
+}
+
+TEST(Materials, CorotationalLinearElasticIsHookesLawForSmallStrains) {
+  // For F = I + eps (eps symmetric, small), tau = lambda tr(eps) I + 2G eps + O(eps^2).
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  Mat3 eps;
+  eps << 1.0, 0.4, -0.2, 0.4, -0.5, 0.3, -0.2, 0.3, 0.7;
+  for (double size : {1e-3, 1e-5}) {
+    const Mat3 e = size * eps;
+    const Mat3 hooke = 2.0 * e.trace() * Mat3::Identity() + 2.0 * 3.0 * e;
+    EXPECT_LT((m->kirchhoff(Mat3::Identity() + e) - hooke).norm(), 30.0 * size * size) << size;
+  }
+}
+
+TEST(Materials, CorotationalLinearElasticPlanarPathMatchesTheFullOne) {
+  // update_stress with planar = true (the closed-form 2x2 square root) equals kirchhoff (the
+  // 3x3 eigen-decomposition) for a block-diagonal F, also after a large rotation in the plane.
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  Mat3 F = Mat3::Identity();
+  F.topLeftCorner<2, 2>() << 1.02, 0.05, -0.03, 0.96;
+  F(2, 2) = 0.99;
+  for (double angle : {0.0, 0.7, 2.5}) {
+    const Mat3 QF = rotation(Eigen::Vector3d(0, 0, 1), angle) * F;
+    const Mat3 L = Mat3::Zero();
+    MaterialPoint point{QF, L, nullptr, 0.0};
+    point.planar = true;
+    SymMat3 tau;
+    m->update_stress(point, tau);
+    const Mat3 full = m->kirchhoff(QF);
+    EXPECT_LT((Mat3(tau) - full).norm(), 1e-14) << angle;
+    EXPECT_NEAR(full(0, 2), 0.0, 1e-15);
+  }
+}
+
+TEST(Materials, SmallStrainLinearElasticWarnsOnceWhenAParticleTurns) {
+  auto m = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}, "small_strain"));
+  const Mat3 L = Mat3::Zero();
+  SymMat3 tau;
+  const Mat3 small_turn = rotation(Eigen::Vector3d(0, 0, 1), 4.0 * std::acos(-1.0) / 180.0);
+  m->update_stress(MaterialPoint{small_turn, L, nullptr, 0.0}, tau);
+  EXPECT_TRUE(m->take_notes().empty());  // 4 degrees: below the stated 5
+  const Mat3 turn = rotation(Eigen::Vector3d(1, 1, 0), 6.0 * std::acos(-1.0) / 180.0);
+  m->update_stress(MaterialPoint{turn, L, nullptr, 0.0}, tau);
+  m->update_stress(MaterialPoint{turn, L, nullptr, 0.0}, tau);
+  const auto notes = m->take_notes();
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("corotational"), std::string::npos) << notes[0];
+  m->update_stress(MaterialPoint{turn, L, nullptr, 0.0}, tau);
+  EXPECT_TRUE(m->take_notes().empty());  // said once per run
+  auto corotational = make_material(config("linear_elastic", {{"lambda", 2.0}, {"shear_modulus", 3.0}}));
+  corotational->update_stress(MaterialPoint{turn, L, nullptr, 0.0}, tau);
+  EXPECT_TRUE(corotational->take_notes().empty());
 }
 
 }  // namespace

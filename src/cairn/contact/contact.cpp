@@ -358,9 +358,9 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     // Point weights: each particle's shape-function weight S_ip at the node (lr_weights =
     // "shape"; docs/contact.md: a flat interface through a regular lattice then gets its exact
     // normal), or w_p = 1 (seed 004 Appendix).
-    if (cfg_.lr_weights != "shape") cloud_w.clear();
+    const auto weights = cfg_.lr_weights == "shape" ? std::span<const double>(cloud_w) : std::span<const double>();
     const auto fit = contact::fit_separating_plane(
-        std::span<const Vec3>(cloud_x), std::span<const signed char>(cloud_c), std::span<const double>(cloud_w),
+        std::span<const Vec3>(cloud_x), std::span<const signed char>(cloud_c), weights,
         Vec3::Zero(), opt, cfg_.normal == "linear" ? contact::PlaneFitMethod::linear : contact::PlaneFitMethod::logistic);
     if (fit.ok) n = fit.normal;
     if (cfg_.lr_refine == "margin") {
@@ -384,8 +384,11 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
   } else if (det == "lr") {
     // Eq. 22-25: edges of the clouds along n with the deformed inscribed-ellipsoid radii.
     double max_a = -std::numeric_limits<double>::infinity(), min_b = std::numeric_limits<double>::infinity();
+    // lr_separation = "column": only the particles within half a cell of the node's line along n.
+    const double column = cfg_.lr_separation == "column" ? 0.5 * cell_width(n) : 0.0;
     for (std::size_t k = 0; k < cloud_x.size(); ++k) {
       const auto p = static_cast<std::size_t>(cloud_p[k]);
+      if (column > 0.0 && (cloud_x[k] - cloud_x[k].dot(n) * n).norm() > column) continue;
       Vec3 R0 = Vec3::Ones();
       for (int a = 0; a < D; ++a) R0[a] = 0.5 * particles.size0[p][a];
       const double R = contact::deformed_radius(particles.deformation_gradient[p], R0, n, D);
@@ -435,7 +438,13 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
   if (record) {
     active_ = 0;
     pair_force_sum_.assign(3 * pairs_.size(), ExactSum());
+    trace_.clear();
   }
+  const bool tracing = record && tracing_;
+  // Kinetic energy the change gives the fields at the nodes this rank owns (a correction that
+  // reaches the particles: docs/contact.md, "Energy"), summed exactly like the forces.
+  const bool count_energy = pass == Pass::updated || (pass == Pass::extrapolated && energy_from_first_);
+  const bool energy_of_free_part = pass == Pass::extrapolated && impulse_;
   // Forces and counts sum over the nodes this rank owns (all of them in a serial run), exactly,
   // so that the totals do not depend on the partition (reduce() adds the ranks).
   auto add_force = [&](int pair, const Vec3& f) {
@@ -479,11 +488,18 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       in.dt = dt;
       in.time = time;
       const ContactLaw& L = *laws_[static_cast<std::size_t>(law)];
-      if (L.bonded()) return in.dp0;
+      using S = NodeTrace::State;
+      auto traced = [&](S state, const Vec3& d) {
+        if (tracing) trace_.push_back({node, it.a, it.b, state, it.normal, it.separation, it.area, in.dp0, d});
+        return d;
+      };
+      if (L.bonded()) return traced(S::bonded, in.dp0);
       // Contact needs approach, (v_b - v_a).n < 0 (Eq. 14), and touching (separation < 0).
-      if (!(it.normal.squaredNorm() > 0.0) || !(in.dp0.dot(it.normal) < 0.0) || !(it.separation < 0.0))
-        return Vec3::Zero();
-      return L.momentum_change(in);
+      if (!(it.normal.squaredNorm() > 0.0)) return traced(S::no_normal, Vec3::Zero());
+      if (!(in.dp0.dot(it.normal) < 0.0)) return traced(S::separating, Vec3::Zero());
+      if (!(it.separation < 0.0)) return traced(S::gap_open, Vec3::Zero());
+      const Vec3 d = L.momentum_change(in);
+      return traced((d - in.dp0).squaredNorm() == 0.0 ? S::stick : S::slip, d);
     };
     if (lumped) {
       // Eq. 50: each field against all others lumped; the change goes to that field only.
@@ -548,6 +564,12 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
     }
     if (!changed) continue;
     if (counted) ++active_;
+    if (count_energy && grid_->owns(node))
+      for (int y = 0; y < k; ++y) {
+        // 1/2 m |v + dp/m|^2 - 1/2 m |v|^2 = dp.v + |dp|^2 / (2m)
+        const Vec3& d = energy_of_free_part ? dp_free[y] : dp_total[y];
+        if (m[y] > 0.0) energy_change_.add(d.dot(p[y]) / m[y] + 0.5 * d.squaredNorm() / m[y]);
+      }
     for (int x = b0; x < b1; ++x) {
       const std::size_t s = slot(x);
       const Vec3& d = dp_total[x - b0];
@@ -577,6 +599,9 @@ void Contact<D>::reduce(const Comm& comm) {
   sum_across(comm, pair_force_sum_.data(), static_cast<int>(pair_force_sum_.size()));
   for (std::size_t k = 0; k < pairs_.size(); ++k)
     for (int a = 0; a < 3; ++a) pair_force_[k][a] = pair_force_sum_.empty() ? 0.0 : pair_force_sum_[3 * k + a].value();
+  sum_across(comm, &energy_change_, 1);
+  dissipated_ -= energy_change_.value();  // this step's passes, over every rank
+  energy_change_ = ExactSum();
   std::int64_t counts[2] = {static_cast<std::int64_t>(active_), 0};
   for (std::int32_t c : nodes_) counts[1] += grid_->owns(c);
   comm.sum(counts, 2);

@@ -59,6 +59,28 @@ class Contact {
   /// Sum the updated pass's forces and counts over the ranks (collective; call once per step
   /// after the updated pass, also in a serial run, before reading the three values below).
   void reduce(const Comm& comm);
+  /// Kinetic energy taken from the fields by the contact corrections so far, over all ranks
+  /// (frictional and impact losses; docs/contact.md, "Energy"): the change of sum m |v|^2 / 2
+  /// at the contact nodes by every updated pass, and by the extrapolated pass when
+  /// count_first_correction(true) says that its change reaches the particle velocities.
+  [[nodiscard]] double dissipated() const { return dissipated_; }
+  void set_dissipated(double value) { dissipated_ = value; }
+  void count_first_correction(bool yes) { energy_from_first_ = yes; }
+  /// What the last updated pass did at one contact node for one field pair (trace(true)).
+  struct NodeTrace {
+    enum State : std::int8_t { bonded, no_normal, separating, gap_open, stick, slip };
+    std::int32_t node = 0;
+    std::int32_t a = 0, b = 0;      ///< fields alpha, beta (b = -1: the others lumped)
+    State state = no_normal;
+    Vec3 normal = Vec3::Zero();     ///< from alpha to beta
+    double separation = 0.0;
+    double area = 0.0;
+    Vec3 dp0 = Vec3::Zero();        ///< the stick change of alpha, m_red (v_b - v_a)
+    Vec3 dp = Vec3::Zero();         ///< the change the law gave alpha (beta got -dp)
+  };
+  /// Record every interaction of the updated pass (a diagnostic: verification/rolling_cylinder).
+  void trace(bool on) { tracing_ = on; }
+  [[nodiscard]] const std::vector<NodeTrace>& last_trace() const { return trace_; }
   /// Nodes that see two or more fields (last prepare), over all ranks.
   [[nodiscard]] std::size_t contact_nodes() const { return contact_total_; }
   /// Nodes where the last updated pass changed the momenta, over all ranks.
@@ -136,6 +158,11 @@ class Contact {
   std::size_t active_total_ = 0, contact_total_ = 0;
   std::vector<int> pair_index_;  ///< n_fields^2 -> index into pairs_
   std::size_t active_ = 0;
+  ExactSum energy_change_;        ///< this rank's energy change since the last reduce()
+  double dissipated_ = 0.0;
+  bool energy_from_first_ = false;
+  bool tracing_ = false;
+  std::vector<NodeTrace> trace_;
   double prepare_seconds_ = 0.0, fit_seconds_ = 0.0, correct_seconds_ = 0.0;
   long long node_steps_ = 0;
 };

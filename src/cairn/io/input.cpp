@@ -1593,6 +1593,7 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
   c.detection = r.string("detection");
   c.critical_separation = r.real("critical_separation");
   c.touching_tolerance = r.real("touching_tolerance");
+  c.lr_separation = r.string("lr_separation");
   c.corrections = r.string("corrections");
   c.three_or_more = r.string("three_or_more");
   c.xpic_correction = r.boolean("xpic_correction");
@@ -1899,6 +1900,7 @@ std::string config_to_toml(const Config& c) {
     line("detection", toml_string(ct.detection));
     line("critical_separation", real_text(ct.critical_separation));
     line("touching_tolerance", real_text(ct.touching_tolerance));
+    line("lr_separation", toml_string(ct.lr_separation));
     line("corrections", toml_string(ct.corrections));
     line("three_or_more", toml_string(ct.three_or_more));
     line("xpic_correction", boolean(ct.xpic_correction));

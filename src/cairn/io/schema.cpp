@@ -512,6 +512,14 @@ std::vector<KeyDecl> make_declarations() {
                  "zero to round-off, which then flips contact on and off).")
                 .by_default("1e-3")
                 .min(0.0));
+  k.push_back(Key("contact", "lr_separation", T::string,
+                 "lr detection: which particles give the two fields' edges at a node: cloud (every "
+                 "particle whose stencil holds the node, seed 004 Eq. 22-24) or column (those within "
+                 "half a cell of the line through the node along the normal: the gap at the node "
+                 "itself, so that a curved surface near the contact point is not taken for touching; "
+                 "docs/contact.md, \"Rolling\").")
+                .by_default("\"cloud\"")
+                .choices([] { return std::vector<std::string>{"cloud", "column"}; }));
   k.push_back(Key("contact", "corrections", T::string,
                  "twice: correct the extrapolated momenta and the updated momenta (seed 004 Eq. "
                  "26-34); once: only the updated momenta (for comparison).")

@@ -1,6 +1,29 @@
-// Small-strain isotropic linear elasticity: eps = sym(F) - I, sigma = lambda tr(eps) I + 2 G eps,
-// W = eps : sigma / 2. Meant for small deformations (the strain is not objective under rotation).
+// Isotropic linear elasticity (Hooke's law, lambda and G) in two forms, chosen by `form`:
+//
+//  "corotational" (default) the strain is measured in the body's own frame: with the polar
+//              decomposition F = R U = V R, the Biot strain E = U - I and the strain energy
+//                  W = G |U - I|^2 + lambda/2 (tr U - 3)^2,
+//              so that P = dW/dF = 2G (F - R) + lambda (tr U - 3) R (the "corotated linear"
+//              energy, McAdams et al. 2011) and the Kirchhoff stress tau = P F^T is
+//                  tau = 2G (B - V) + lambda (tr V - 3) V,   B = F F^T = V^2,
+//              which needs only the left stretch V = sqrt(B), never R. W depends on F only
+//              through U, so a rigid rotation adds no stress (objective) and the model is
+//              hyperelastic (the history's strain energy balances the stress power exactly).
+//              For small strains tau = lambda tr(eps) I + 2G eps + O(eps^2) in the rotated
+//              frame: Hooke's law for small strains and any rotation.
+//  "small_strain" eps = sym(F) - I, sigma = lambda tr(eps) I + 2 G eps, W = eps : sigma / 2
+//              (seed 003 Sec. 6's linear elasticity). Not objective: a rotation by theta alone
+//              gives a strain of (cos theta - 1) across the rotation plane. Each material of
+//              this form warns once when a particle's rotation passes kWarnAngleDeg.
+//
+// In 1D (uniaxial strain, F = diag(f, 1, 1), f > 0) the two forms are the same function:
+// tau_xx = f (f - 1)(lambda + 2G).
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <numbers>
+
+#include <Eigen/Eigenvalues>
 
 #include "cairn/materials/elastic_constants.hpp"
 #include "cairn/materials/material.hpp"
@@ -8,18 +31,72 @@
 namespace cairn {
 namespace {
 
+constexpr double kWarnAngleDeg = 5.0;  ///< small_strain: the rotation that triggers the warning
+
+enum class Form { corotational, small_strain };
+
+Form parse_form(const MaterialConfig& cfg) {
+  const auto it = cfg.strings.find("form");
+  return it != cfg.strings.end() && it->second == "small_strain" ? Form::small_strain : Form::corotational;
+}
+
+/// The Biot-type strain E = V - I of the left stretch V = sqrt(F F^T) (symmetric; det F > 0),
+/// computed from the displacement gradient H = F - I (exact: F near I) so that it keeps the
+/// precision of H however small the strain: with D = B - I = H + H^T + H H^T,
+///  - planar F (block diagonal, 2x2 block): for a 2x2 SPD matrix M, sqrt(M) = (M + s I) / t with
+///    s = sqrt(det M), t = sqrt(tr M + 2 s) (Cayley-Hamilton for X = sqrt M: X^2 = tr(X) X -
+///    det(X) I, tr X = t, det X = s). With s = 1 + ds and t = 2 + dt, E = (D + (ds - dt) I) / t,
+///    dt = 2x / (1 + sqrt(1 + x)), x = (tr D + 2 ds) / 4; E_zz = |F_zz| - 1.
+///  - full F: the eigen-decomposition D = Q diag(d) Q^T (Eigen's closed form for symmetric 3x3
+///    matrices) and E = Q diag(d / (1 + sqrt(1 + d))) Q^T.
+Mat3 stretch_strain(const Mat3& F, bool planar) {
+  const Mat3 H = F - Mat3::Identity();
+  if (planar) {
+    const Eigen::Matrix2d h = H.topLeftCorner<2, 2>();
+    const Eigen::Matrix2d D = h + h.transpose() + h * h.transpose();
+    const double det_h = h(0, 0) * h(1, 1) - h(0, 1) * h(1, 0);
+    const double det_f = 1.0 + h.trace() + det_h;
+    const double ds = det_f > 0.0 ? h.trace() + det_h : -det_f - 1.0;  // s - 1, s = |det F_2|
+    const double x = 0.25 * (D.trace() + 2.0 * ds);
+    const double dt = 2.0 * x / (1.0 + std::sqrt(1.0 + x));  // t - 2
+    Mat3 E = Mat3::Zero();
+    E.topLeftCorner<2, 2>() = (D + (ds - dt) * Eigen::Matrix2d::Identity()) / (2.0 + dt);
+    E(2, 2) = std::abs(F(2, 2)) - 1.0;
+    return E;
+  }
+  const Mat3 D = H + H.transpose() + H * H.transpose();
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+  eigen.computeDirect(D);
+  Eigen::Vector3d e;
+  for (int i = 0; i < 3; ++i) {
+    const double d = std::max(eigen.eigenvalues()[i], -1.0);
+    e[i] = d / (1.0 + std::sqrt(1.0 + d));
+  }
+  return eigen.eigenvectors() * e.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+bool is_planar(const Mat3& F) {
+  return F(0, 2) == 0.0 && F(1, 2) == 0.0 && F(2, 0) == 0.0 && F(2, 1) == 0.0;
+}
+
 class LinearElastic final : public Material {
  public:
-  explicit LinearElastic(const MaterialConfig& cfg) : Material(cfg), c_(elastic_constants(cfg)) {}
+  explicit LinearElastic(const MaterialConfig& cfg)
+      : Material(cfg), c_(elastic_constants(cfg)), form_(parse_form(cfg)) {}
 
-  Mat3 cauchy(const Mat3& F) const {
-    const Mat3 eps = 0.5 * (F + F.transpose()) - Mat3::Identity();
-    return c_.lambda * eps.trace() * Mat3::Identity() + 2.0 * c_.shear * eps;
+  Mat3 kirchhoff(const Mat3& F) const override {
+    if (form_ == Form::corotational) return corotational(stretch_strain(F, is_planar(F)));
+    return F.determinant() * small_strain_cauchy(F);
   }
-  Mat3 kirchhoff(const Mat3& F) const override { return F.determinant() * cauchy(F); }
-  // The same, written as six components (eps is symmetric); planar F: J from the 2x2 block.
+
   void update_stress(const MaterialPoint& point, SymMat3& tau) const override {
     const Mat3& F = point.F;
+    if (form_ == Form::corotational) {
+      tau = corotational(stretch_strain(F, point.planar));
+      return;
+    }
+    watch_rotation(F);
+    // Six components directly (eps is symmetric); planar F: J from the 2x2 block.
     const double J = point.planar ? (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * F(2, 2) : F.determinant();
     const double exx = F(0, 0) - 1.0, eyy = F(1, 1) - 1.0, ezz = F(2, 2) - 1.0;
     const double pressure_part = c_.lambda * (exx + eyy + ezz), G2 = 2.0 * c_.shear;
@@ -28,21 +105,71 @@ class LinearElastic final : public Material {
          J * (c_.shear * (F(1, 2) + F(2, 1))), J * (c_.shear * (F(0, 2) + F(2, 0))),
          J * (c_.shear * (F(0, 1) + F(1, 0)))};
   }
+
   double energy_density(const Mat3& F) const override {
+    if (form_ == Form::corotational) {
+      const Mat3 E = stretch_strain(F, is_planar(F));  // V - I: the invariants of U - I
+      return c_.shear * E.squaredNorm() + 0.5 * c_.lambda * E.trace() * E.trace();
+    }
     const Mat3 eps = 0.5 * (F + F.transpose()) - Mat3::Identity();
-    return 0.5 * eps.cwiseProduct(cauchy(F)).sum();
+    return 0.5 * eps.cwiseProduct(small_strain_cauchy(F)).sum();
   }
   double wave_speed(const Mat3&) const override {
     return std::sqrt((c_.lambda + 2.0 * c_.shear) / density());
   }
   bool wave_speed_varies() const override { return false; }
 
+  std::vector<std::string> take_notes() const override {
+    int seen = 1;
+    if (!warned_.compare_exchange_strong(seen, 2)) return {};
+    return {"warning: material '" + name() + "' (linear_elastic, form = \"small_strain\"): a particle turned by more than " +
+            std::to_string(static_cast<int>(kWarnAngleDeg)) +
+            " degrees; the small-strain form reads a rotation as strain (a turn by theta gives a strain of "
+            "cos(theta) - 1 and the matching stress). Use form = \"corotational\" (the default) for bodies "
+            "that turn (docs/materials.md)."};
+  }
+
  private:
+  /// tau = 2G (B - V) + lambda (tr V - 3) V = 2G (E + E^2) + lambda tr(E) (I + E), E = V - I.
+  Mat3 corotational(const Mat3& E) const {
+    const double trE = E.trace();
+    Mat3 tau = 2.0 * c_.shear * (E + E * E) + c_.lambda * trE * E;
+    tau.diagonal().array() += c_.lambda * trE;
+    return tau;
+  }
+  Mat3 small_strain_cauchy(const Mat3& F) const {
+    const Mat3 eps = 0.5 * (F + F.transpose()) - Mat3::Identity();
+    return c_.lambda * eps.trace() * Mat3::Identity() + 2.0 * c_.shear * eps;
+  }
+  /// Flags (once) a rotation beyond kWarnAngleDeg, estimated from the skew part of F: for
+  /// F = R U with U near I, |axial(F - F^T)| / 2 = sin(theta).
+  void watch_rotation(const Mat3& F) const {
+    if (warned_.load(std::memory_order_relaxed) != 0) return;
+    const double wx = F(2, 1) - F(1, 2), wy = F(0, 2) - F(2, 0), wz = F(1, 0) - F(0, 1);
+    static const double limit = 2.0 * std::sin(kWarnAngleDeg * std::numbers::pi / 180.0);
+    if (wx * wx + wy * wy + wz * wz > limit * limit) {
+      int none = 0;
+      warned_.compare_exchange_strong(none, 1);
+    }
+  }
+
   ElasticConstants c_;
+  Form form_;
+  mutable std::atomic<int> warned_{0};  ///< 0: no, 1: seen, not yet said, 2: said
 };
 
 MaterialModelInfo info() {
-  return {"small-strain isotropic linear elasticity", elastic_constant_keys(), &check_elastic_constants};
+  auto keys = elastic_constant_keys();
+  KeyDecl form;
+  form.section = "material";
+  form.name = "form";
+  form.type = KeyType::string;
+  form.default_value = "\"corotational\"";
+  form.choices = [] { return std::vector<std::string>{"corotational", "small_strain"}; };
+  form.doc = "corotational: Hooke's law on the Biot strain U - I of F = R U (objective, any rotation); "
+             "small_strain: eps = sym(F) - I (seed 003 Sec. 6; not objective, warns past 5 degrees of rotation)";
+  keys.push_back(form);
+  return {"isotropic linear elasticity (corotational or small-strain)", keys, &check_elastic_constants};
 }
 
 }  // namespace

@@ -80,6 +80,10 @@ class Material {
   /// loop makes one virtual call per particle and no 3x3 temporary.
   virtual void update_stress(const MaterialPoint& point, SymMat3& tau) const { tau = update(point); }
 
+  /// Messages the model has for the user since the last call (e.g. a warning said once per run);
+  /// the run prints them between steps. Called from one thread.
+  [[nodiscard]] virtual std::vector<std::string> take_notes() const { return {}; }
+
  private:
   std::string name_;
   double density_;

@@ -114,6 +114,7 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
   if (const auto* c = sim.contact()) {
     columns.push_back("contact_nodes");
     columns.push_back("contact_active");
+    columns.push_back("contact_dissipated_energy");
     for (const auto& [a, b] : c->pairs())
       for (int k = 0; k < D; ++k)
         columns.push_back(fmt::format("contact_{}_{}_{}", c->field_names()[a], c->field_names()[b], "xyz"[k]));
@@ -179,8 +180,12 @@ class Runner {
       throw std::invalid_argument(problem);
     }
     sim_.set_particles(data.particles);
+    // contact_dissipated_energy: absent from checkpoints written before issue 38 (counted as 0).
+    const auto contact_part = data.scalars.find("contact_dissipated_energy");
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
-                          data.scalars.at("dissipated_energy"), data.scalars.at("next_full_mass_time"));
+                          data.scalars.at("dissipated_energy"),
+                          contact_part == data.scalars.end() ? 0.0 : contact_part->second,
+                          data.scalars.at("next_full_mass_time"));
     auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
@@ -326,6 +331,7 @@ class Runner {
     if (const auto* c = sim_.contact()) {
       row.push_back(static_cast<double>(c->contact_nodes()));
       row.push_back(static_cast<double>(c->active_nodes()));
+      row.push_back(c->dissipated());
       for (const auto& f : c->pair_forces())
         for (int a = 0; a < D; ++a) row.push_back(f[a]);
     }
@@ -395,7 +401,8 @@ class Runner {
     data.step = sim_.step_count();
     data.previous_dt = last_dt_;
     data.scalars = {{"external_work", sim_.external_work()},
-                    {"dissipated_energy", sim_.dissipated_energy()},
+                    {"dissipated_energy", sim_.update_dissipated_energy()},
+                    {"contact_dissipated_energy", sim_.contact_dissipated_energy()},
                     {"next_full_mass_time", sim_.next_full_mass_time()},
                     {"initial_energy", initial_energy_},
                     {"checkpoint_index", static_cast<double>(checkpoint_index_)}};

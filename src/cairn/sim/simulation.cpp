@@ -122,6 +122,10 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // Multimaterial mode: one field per material or body, side by side (contact/contact.hpp).
     contact_ = std::make_unique<Contact<D>>(config_, grid_, particles_, small_mass_);
     n_fields_ = contact_->n_fields();
+    // The first correction's contact change reaches the particle velocities as an impulse
+    // (first_correction = "impulse"); otherwise only the second correction's does (the particle
+    // update takes v+ - v, or v+ whose change the dissipation tally of the update already sees).
+    contact_->count_first_correction(contact_->impulse() && contact_->corrects_extrapolation());
   }
   // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
   // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
@@ -384,8 +388,26 @@ void Simulation<D>::set_particles(Particles<D> particles) {
 }
 
 template <int D>
+double Simulation<D>::contact_dissipated_energy() const {
+  return contact_ ? contact_->dissipated() : 0.0;
+}
+
+template <int D>
+void Simulation<D>::restore_counters(double time, long long step, double external_work, double update_dissipated,
+                                     double contact_dissipated, double next_full_mass_time) {
+  time_ = time;
+  step_ = step;
+  external_work_ = external_work;
+  dissipated_energy_ = update_dissipated;
+  if (contact_) contact_->set_dissipated(contact_dissipated);
+  next_full_mass_time_ = next_full_mass_time;
+}
+
+template <int D>
 std::vector<std::string> Simulation<D>::take_notes() {
   std::vector<std::string> notes = velocity_conditions_.take_notes();
+  for (const auto& m : materials_)
+    for (auto& note : m->take_notes()) notes.push_back(std::move(note));
   if (!distributed()) return notes;
   const Comm& comm = distribution_.comm();
   if (!comm.any(!notes.empty())) return {};

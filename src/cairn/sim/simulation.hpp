@@ -119,6 +119,7 @@ class Simulation {
   [[nodiscard]] const wls::Integrator<D>* wls() const { return wls_.get(); }
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
+  [[nodiscard]] Contact<D>* contact() { return contact_.get(); }
   /// Node fields summed over the material fields (mass, momentum, velocity_new as m-weighted
   /// mean); the node fields themselves in single-field mode. For grid snapshots.
   [[nodiscard]] NodeField<D> grid_totals() const;
@@ -130,18 +131,17 @@ class Simulation {
   [[nodiscard]] long long step_count() const { return step_; }
   /// Work done on the particles by body forces and velocity conditions so far.
   [[nodiscard]] double external_work() const { return external_work_; }
-  /// Energy dissipated by the particle update so far (seed 002 Eq. 1.47-1.50).
-  [[nodiscard]] double dissipated_energy() const { return dissipated_energy_; }
+  /// Energy dissipated so far: by the particle update (seed 002 Eq. 1.47-1.50) and by contact
+  /// corrections (friction and impact losses, Contact::dissipated).
+  [[nodiscard]] double dissipated_energy() const { return dissipated_energy_ + contact_dissipated_energy(); }
+  /// The particle update's part of dissipated_energy().
+  [[nodiscard]] double update_dissipated_energy() const { return dissipated_energy_; }
+  /// The contact corrections' part of dissipated_energy() (0 without contact).
+  [[nodiscard]] double contact_dissipated_energy() const;
   /// Time of the next full-mass step of periodic FMPM/XPIC (method.full_mass_cfl > 0).
   [[nodiscard]] double next_full_mass_time() const { return next_full_mass_time_; }
-  void restore_counters(double time, long long step, double external_work, double dissipated,
-                        double next_full_mass_time) {
-    time_ = time;
-    step_ = step;
-    external_work_ = external_work;
-    dissipated_energy_ = dissipated;
-    next_full_mass_time_ = next_full_mass_time;
-  }
+  void restore_counters(double time, long long step, double external_work, double update_dissipated,
+                        double contact_dissipated, double next_full_mass_time);
   [[nodiscard]] Totals totals() const;
 
   // ---- loads and velocity conditions (docs/boundary-conditions.md) ---------------------------
