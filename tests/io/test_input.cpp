@@ -192,8 +192,8 @@ TEST(InputErrors, SetOfUnknownKey) {
             "contact, contact_pair, fem, output (did you mean "
             "'material'?); found an undeclared key");
   // The model decides the keys of a [[material]].
-  EXPECT_EQ(message(error_of(base, {"material.0.form=\"ln_j\""})).rfind(
-                "--set material.0.form=\"ln_j\": key 'material[0].form': expected a key declared for [[material]]",
+  EXPECT_EQ(message(error_of(base, {"material.0.gamma0=2"})).rfind(
+                "--set material.0.gamma0=2: key 'material[0].gamma0': expected a key declared for [[material]]",
                 0),
             0u);
   EXPECT_EQ(message(error_of(base, {"body.0.shape.cube.min=[0,0]"})).rfind(
