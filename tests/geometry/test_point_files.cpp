@@ -8,6 +8,7 @@
 
 #include "../support/scratch_test.hpp"
 #include "cairn/io/errors.hpp"
+#include "cairn/io/hdf5_util.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
@@ -16,14 +17,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string input(int dim, const std::string& velocity = "") {
+std::string input(int dim, const std::string& velocity = "", const std::string& file = "points.csv") {
   const std::string v3 = dim == 3 ? ", 0.0" : "";
   return "[simulation]\ndimension = " + std::to_string(dim) +
          "\nend_time = 1.0e-4\nthickness = 0.5\n\n[grid]\norigin = [0.0, 0.0" + v3 + "]\nextent = [1.0, 1.0" +
          (dim == 3 ? ", 1.0" : "") +
          "]\ncell_size = 0.1\n\n[[material]]\nname = \"m\"\nmodel = \"linear_elastic\"\ndensity = 2000.0\n"
          "youngs_modulus = 1.0e6\npoissons_ratio = 0.3\n\n[[body]]\nname = \"cloud\"\nmaterial = \"m\"\n"
-         "shape = { points = { file = \"points.csv\" } }\n" +
+         "shape = { points = { file = \"" + file + "\" } }\n" +
          velocity;
 }
 
@@ -80,6 +81,37 @@ TEST_F(PointFiles, TwoDimensionalAreasTakeTheThicknessAndTheBodyVelocityApplies)
   }
   EXPECT_NEAR(volume, 0.06 * 0.5, 1e-15);
   EXPECT_NEAR(mass, 2000.0 * 0.06 * 0.5, 1e-12);
+}
+
+TEST_F(PointFiles, Hdf5DatasetsGiveTheSameParticles) {
+  const double position[6] = {0.25, 0.5, 0.5, 0.75, 0.5, 0.5}, volume[2] = {1.0e-3, 8.0e-3};
+  const double velocity[6] = {1.0, 0.0, -2.0, 0.0, 3.0, 0.0};
+  {
+    const h5::Handle file = h5::create_file(path("points.h5"));
+    h5::write_doubles(file.get(), "position", position, 2, 3);
+    h5::write_doubles(file.get(), "volume", volume, 2);
+    h5::write_doubles(file.get(), "velocity", velocity, 2, 3);
+  }
+  std::string text = input(3, "", "points.h5");
+  text.replace(text.find("thickness = 0.5\n"), 16, "");
+  write("case.toml", text);
+  const Config cfg = load_config(path("case.toml"));
+  Simulation<3> sim(cfg);
+  const auto& p = sim.particles();
+  ASSERT_EQ(p.n(), 2u);
+  EXPECT_EQ(p.position[1], Vec<3>(0.75, 0.5, 0.5));
+  EXPECT_DOUBLE_EQ(p.mass[1], 2000.0 * 8.0e-3);
+  EXPECT_EQ(p.velocity[0], Vec<3>(1.0, 0.0, -2.0));
+
+  {
+    const h5::Handle file = h5::create_file(path("bad.h5"));
+    h5::write_doubles(file.get(), "position", position, 3, 2);
+    h5::write_doubles(file.get(), "volume", volume, 2);
+  }
+  text.replace(text.find("points.h5"), 9, "bad.h5");
+  write("case.toml", text);
+  const std::string e = input_error([&] { load_config(path("case.toml")); });
+  EXPECT_NE(e.find("dataset 'position' of shape [3, 2], not n x 3"), std::string::npos) << e;
 }
 
 TEST_F(PointFiles, BadFilesAreInputErrorsNamingTheLine) {

@@ -120,6 +120,20 @@ TEST_F(SurfaceMeshBodies, CubeInEveryFormatFillsExactlyItsLatticePoints) {
   }
 }
 
+TEST_F(SurfaceMeshBodies, ObjQuadsAreTriangulated) {
+  // Blender's OBJ export writes quads: the cube [0.25, 0.75]^3 as 6 of them, counter-clockwise
+  // seen from outside.
+  write("quads.obj",
+        "v 0.25 0.25 0.25\nv 0.75 0.25 0.25\nv 0.75 0.75 0.25\nv 0.25 0.75 0.25\n"
+        "v 0.25 0.25 0.75\nv 0.75 0.25 0.75\nv 0.75 0.75 0.75\nv 0.25 0.75 0.75\n"
+        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 3 4 8 7\nf 2 3 7 6\nf 1 5 8 4\n");
+  const Config cfg = load("file = \"quads.obj\"");
+  EXPECT_TRUE(cfg.warnings.empty());
+  EXPECT_EQ(cfg.bodies[0].shape.mesh->n_triangles(), 12u);
+  EXPECT_NEAR(cfg.bodies[0].shape.mesh->volume(), 0.125, 1e-12);
+  EXPECT_EQ(particles_of(Simulation<3>(cfg)).size(), 8000u);
+}
+
 /// Sphere and torus: every lattice point the analytic body holds with a margin `band` from its
 /// surface is a particle and no point outside it by `band` is; the particle volume is within the
 /// documented bound A l / 10 of the mesh's volume (docs/geometry.md, "How close the volume is").

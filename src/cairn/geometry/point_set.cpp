@@ -4,23 +4,25 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <hdf5.h>
+
 #include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <filesystem>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <stdexcept>
 
+#include "cairn/geometry/text.hpp"
+
+#include "cairn/io/hdf5_util.hpp"
+
 namespace cairn::geometry {
 
 namespace {
-
-std::string trim(const std::string& s) {
-  const auto a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
 
 std::vector<std::string> fields(const std::string& line) {
   std::vector<std::string> out;
@@ -34,7 +36,65 @@ std::vector<std::string> fields(const std::string& line) {
   return out;
 }
 
-}  // namespace
+void add_bounds(PointSet& set, const std::array<double, 3>& x) {
+  for (std::size_t a = 0; a < static_cast<std::size_t>(set.dimension); ++a) {
+    set.lo[a] = std::min(set.lo[a], x[a]);
+    set.hi[a] = std::max(set.hi[a], x[a]);
+  }
+}
+
+std::shared_ptr<const PointSet> read_point_h5(const std::string& path, int dimension) {
+  auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(fmt::format("point file '{}': {}", path, what));
+  };
+  auto set = std::make_shared<PointSet>();
+  set->file = path;
+  set->dimension = dimension;
+  for (auto& v : set->lo) v = std::numeric_limits<double>::infinity();
+  for (auto& v : set->hi) v = -std::numeric_limits<double>::infinity();
+  const auto d = static_cast<std::size_t>(dimension);
+  try {
+    const h5::Handle file = h5::open_file(path);
+    const hid_t root = file.get();
+    auto has = [&](const char* name) { return H5Lexists(root, name, H5P_DEFAULT) > 0; };
+    for (const char* need : {"position", "volume"})
+      if (!has(need)) fail(fmt::format("no dataset '{}' (datasets: position n x {}, volume n; optional velocity, "
+                                       "temperature)",
+                                       need, dimension));
+    const auto shape = h5::dataset_shape(root, "position");
+    if (shape.size() != 2 || shape[1] != d || shape[0] == 0)
+      fail(fmt::format("dataset 'position' of shape [{}], not n x {} with n > 0", fmt::join(shape, ", "), dimension));
+    const std::size_t n = shape[0];
+    auto read = [&](const char* name, std::size_t cols) {
+      const std::vector<double> v =
+          h5::read_doubles(root, name, cols ? std::vector<std::size_t>{n, cols} : std::vector<std::size_t>{n});
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (!std::isfinite(v[i])) fail(fmt::format("dataset '{}', entry {}: not a finite number", name, i));
+      return v;
+    };
+    const std::vector<double> position = read("position", d), volume = read("volume", 0);
+    const std::vector<double> velocity = has("velocity") ? read("velocity", d) : std::vector<double>{};
+    const std::vector<double> temperature = has("temperature") ? read("temperature", 0) : std::vector<double>{};
+    for (std::size_t i = 0; i < n; ++i) {
+      std::array<double, 3> x{0.0, 0.0, 0.0};
+      for (std::size_t a = 0; a < d; ++a) x[a] = position[i * d + a];
+      if (!(volume[i] > 0.0)) fail(fmt::format("dataset 'volume', entry {}: {} is not above zero", i, volume[i]));
+      add_bounds(*set, x);
+      set->position.push_back(x);
+      set->volume.push_back(volume[i]);
+      set->total_volume += volume[i];
+      if (!velocity.empty()) {
+        std::array<double, 3> v{0.0, 0.0, 0.0};
+        for (std::size_t a = 0; a < d; ++a) v[a] = velocity[i * d + a];
+        set->velocity.push_back(v);
+      }
+      if (!temperature.empty()) set->temperature.push_back(temperature[i]);
+    }
+  } catch (const std::runtime_error& e) {  // HDF5 failures (h5:: helpers)
+    fail(e.what());
+  }
+  return set;
+}
 
 std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dimension) {
   auto fail = [&](long line, const std::string& what) -> void {
@@ -90,11 +150,8 @@ std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dime
       return v;
     };
     std::array<double, 3> x{0.0, 0.0, 0.0};
-    for (int a = 0; a < dimension; ++a) {
-      x[static_cast<std::size_t>(a)] = value(axes[static_cast<std::size_t>(a)]);
-      set->lo[static_cast<std::size_t>(a)] = std::min(set->lo[static_cast<std::size_t>(a)], x[static_cast<std::size_t>(a)]);
-      set->hi[static_cast<std::size_t>(a)] = std::max(set->hi[static_cast<std::size_t>(a)], x[static_cast<std::size_t>(a)]);
-    }
+    for (int a = 0; a < dimension; ++a) x[static_cast<std::size_t>(a)] = value(axes[static_cast<std::size_t>(a)]);
+    add_bounds(*set, x);
     const double vol = value("volume");
     if (!(vol > 0.0)) fail(number, fmt::format("volume {} is not above zero", vol));
     set->position.push_back(x);
@@ -110,6 +167,14 @@ std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dime
   if (column.empty()) fail(0, "no header row (an empty file?)");
   if (set->position.empty()) fail(0, "a header but no particle rows");
   return set;
+}
+
+}  // namespace
+
+std::shared_ptr<const PointSet> read_point_file(const std::string& path, int dimension) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".h5" || ext == ".hdf5" ? read_point_h5(path, dimension) : read_point_csv(path, dimension);
 }
 
 }  // namespace cairn::geometry

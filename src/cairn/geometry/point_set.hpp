@@ -1,7 +1,10 @@
-// Particles given one by one ([[body]] shape `points`, docs/geometry.md): a CSV file of
+// Particles given one by one ([[body]] shape `points`, docs/geometry.md): a CSV or HDF5 file of
 // positions and volumes (from another code, a DEM packing, a script), with optional initial
 // velocities and temperatures. Each row becomes one particle of the body with that volume and
 // mass = density x volume.
+//
+// The HDF5 file (.h5, .hdf5): double datasets `position` (n x D), `volume` (n), optional
+// `velocity` (n x D) and `temperature` (n) at its root.
 //
 // The CSV file: a header row naming the columns, then one row per particle, fields separated by
 // commas; blank lines and lines starting with '#' are skipped. Columns: x, y (2D, 3D), z (3D),
@@ -30,9 +33,10 @@ struct PointSet {
   [[nodiscard]] std::size_t n() const { return position.size(); }
 };
 
-/// Read the CSV point file `path` for a model of `dimension` axes. Throws std::invalid_argument
-/// naming the file, the line and what is wrong (a missing or unknown column, a field that is not
-/// a finite number, a row with another number of fields, a volume not above zero, no rows).
-std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dimension);
+/// Read the point file `path` (HDF5 for .h5 / .hdf5, else CSV) for a model of `dimension` axes.
+/// Throws std::invalid_argument naming the file, the line or dataset and what is wrong (a
+/// missing or unknown column or dataset, a wrong shape, a value that is not a finite number, a
+/// row with another number of fields, a volume not above zero, no particles).
+std::shared_ptr<const PointSet> read_point_file(const std::string& path, int dimension);
 
 }  // namespace cairn::geometry

@@ -15,9 +15,12 @@ const std::vector<ShapeKindDecl>& shape_kinds() {
       {"volume_mesh", {false, true, true},
        "Elements of a Gmsh mesh (.msh, or .geo meshed on reading): 3-node triangles (2D) or 4-node "
        "tetrahedra (3D), one particle per element or per quadrature point (docs/geometry.md)."},
+      {"outline", {false, true, false},
+       "Inside of closed loops read from a CSV file, the first the outside and the others holes "
+       "(docs/geometry.md)."},
       {"points", {false, true, true},
-       "Particles given one by one in a CSV file: position, volume, optional velocity and "
-       "temperature per row (docs/geometry.md)."},
+       "Particles given one by one in a CSV or HDF5 file: position, volume, optional velocity and "
+       "temperature (docs/geometry.md)."},
   };
   return kinds;
 }
@@ -64,9 +67,19 @@ std::vector<KeyDecl> shape_keys() {
   k.back().max = 4;
   for (std::size_t i = 1; i < n_mesh; ++i) k.push_back(k[i]);  // units, scale, rotate, translate
   for (std::size_t i = n_mesh; i < k.size(); ++i) k[i].section = "body.shape.volume_mesh";
+  // outline: the file and its placement.
+  const std::size_t n_outline = k.size();
+  k.push_back(key("file", KeyType::string, "",
+                  "CSV file of vertices \"x, y\", one per line, loops separated by blank lines: the first "
+                  "loop the outside, the others holes; relative to the input file's directory."));
+  k.push_back(key("scale", KeyType::real, "1.0", "Factor on the file's coordinates."));
+  k.back().min = std::numeric_limits<double>::denorm_min();
+  k.push_back(key("translate", KeyType::real_array, "[0.0, 0.0]", "Shift [x, y] applied after scale."));
+  for (std::size_t i = n_outline; i < k.size(); ++i) k[i].section = "body.shape.outline";
   KeyDecl points = key("file", KeyType::string, "",
-                        "CSV file with a header row: x, y (, z), volume (an area in 2D), optional vx, vy (, vz) "
-                        "and temperature; one particle per row, relative to the input file's directory.");
+                        "CSV file with a header row x, y (, z), volume (an area in 2D), optional vx, vy (, vz) and "
+                        "temperature, one particle per row; or HDF5 (.h5, .hdf5) with datasets position (n x D), "
+                        "volume (n), optional velocity, temperature. Relative to the input file's directory.");
   points.section = "body.shape.points";
   k.push_back(points);
   return k;

@@ -16,7 +16,8 @@ struct ShapeKindDecl {
   std::string doc;
 };
 
-/// The shape kinds read from files: mesh (3D surface meshes), points (CSV point files).
+/// The shape kinds read from files: mesh (3D surface meshes), volume_mesh (Gmsh elements),
+/// outline (2D loops with holes), points (CSV point files).
 const std::vector<ShapeKindDecl>& shape_kinds();
 
 /// Their parameters, as key declarations of sections "body.shape.<kind>".

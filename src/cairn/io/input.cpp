@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/geometry/outline.hpp"
 #include "cairn/geometry/point_set.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/geometry/volume_mesh.hpp"
@@ -1200,11 +1201,19 @@ BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConf
     }
   } else if (kind == "mesh" || kind == "volume_mesh") {
     read_mesh_shape(r, s, earlier);
+  } else if (kind == "outline") {
+    s.file = file_key(r);
+    s.scale = r.real("scale");
+    s.translate = r.reals("translate", 2, false);
+    s.loops = read_file_key(r, "a CSV outline: lines \"x, y\", loops separated by blank lines, the first the "
+                               "outside and the others holes inside it, no two edges meeting (docs/geometry.md)",
+                            [&] { return geometry::read_outline_csv(s.file, s.scale, s.translate); });
   } else if (kind == "points") {
     s.file = file_key(r);
-    s.points = read_file_key(r, "a CSV point file: a header row x, y(, z), volume[, vx, vy(, vz)][, temperature], "
-                                "then one row per particle (docs/geometry.md)",
-                             [&] { return geometry::read_point_csv(s.file, dim_); });
+    s.points = read_file_key(r, "a point file: CSV with a header row x, y(, z), volume[, vx, vy(, vz)][, temperature] "
+                                "and one row per particle, or HDF5 (.h5) with datasets position, volume[, velocity]"
+                                "[, temperature] (docs/geometry.md)",
+                             [&] { return geometry::read_point_file(s.file, dim_); });
   } else {
     throw std::logic_error("input: shape kind '" + kind + "' declared but not read");
   }
@@ -1777,6 +1786,9 @@ std::string shape_text(const BodyShapeConfig& s) {
   else if (s.kind == "image")
     params = fmt::format("file = {}, pixel_size = {}, origin = {}, levels = [{}, {}]", toml_string(s.file),
                          real_text(s.pixel_size), reals_text(s.origin), s.level_min, s.level_max);
+  else if (s.kind == "outline")
+    params = fmt::format("file = {}, scale = {}, translate = {}", toml_string(s.file), real_text(s.scale),
+                         reals_text(s.translate));
   else if (s.kind == "points")
     params = fmt::format("file = {}", toml_string(s.file));
   else if (s.kind == "mesh" || s.kind == "volume_mesh")

@@ -739,6 +739,7 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.image.levels", "integer[2]"},
       {"body.shape.mesh.rotate", "real[3]"},
       {"body.shape.mesh.translate", "real[3]"},
+      {"body.shape.outline.translate", "real[2]"},
       {"body.shape.volume_mesh.rotate", "real[3]"},
       {"body.shape.volume_mesh.translate", "real[3]"},
       {"traction.table", "real[2][n]"},

@@ -16,6 +16,13 @@
 // (to 1e-6 pixel, so that rounding does not decide) belongs to the pixel on its +x / +y side:
 // lattices whose points fall on pixel corners sample the picture consistently.
 //
+// Shapes from files (docs/geometry.md): a mesh (3D) keeps X when X is inside its closed surface
+// (geometry/surface_mesh.hpp; the lattice is visited line by line along x, which is what the
+// surface's per-line memo is for); an outline (2D) by the even-odd rule over its loops, as a
+// polygon; volume_mesh and points replace the lattice by their own particles (geometry/
+// volume_mesh.hpp, point_set.hpp), each with its own volume and a domain of a square/cube of that
+// volume, a point file's velocities and temperatures replacing the body's.
+//
 // Only the lattice points inside the shape's bounds are visited (sim/resources.hpp), in the same
 // order as a sweep of the whole grid would visit them. A shape reaching past the grid is an error
 // unless the body says clip = true; bodies sharing space (a particle of one inside another's
@@ -29,6 +36,7 @@
 #include <stdexcept>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/geometry/outline.hpp"
 #include "cairn/geometry/point_set.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
@@ -70,16 +78,10 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, geometry::LineCach
     return r >= s.inner_radius && r <= s.outer_radius;
   }
   if (s.kind == "polygon") {
-    if constexpr (D == 2) {
-      bool in = false;  // even-odd crossing rule
-      const auto& v = s.vertices;
-      for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
-        if ((v[i][1] > x[1]) != (v[j][1] > x[1]) &&
-            x[0] < (v[j][0] - v[i][0]) * (x[1] - v[i][1]) / (v[j][1] - v[i][1]) + v[i][0])
-          in = !in;
-      }
-      return in;
-    }
+    if constexpr (D == 2) return geometry::inside_loop(s.vertices, x[0], x[1]);  // even-odd crossing rule
+  }
+  if (s.kind == "outline") {
+    if constexpr (D == 2) return geometry::inside_loops(s.loops, x[0], x[1]);  // holes by the same rule
   }
   if (s.kind == "mesh" && s.mesh) {
     if constexpr (D == 3) return s.mesh->inside(x[0], x[1], x[2], line);

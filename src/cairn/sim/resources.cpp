@@ -11,6 +11,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "cairn/geometry/outline.hpp"
 #include "cairn/geometry/point_set.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
@@ -115,6 +116,14 @@ ShapeBounds<D> shape_bounds(const BodyShapeConfig& s, const GreyImage* image, co
     b.hi[D - 1] = o[D - 1] + (image->height - r0) * px;
     if (in_level > 0)
       b.fill = static_cast<double>(in_level) / (static_cast<double>(c1 - c0 + 1) * (r1 - r0 + 1));
+  } else if (s.kind == "outline" && D == 2 && !s.loops.empty()) {
+    b.lo = b.hi = vec<D>(s.loops[0][0]);
+    for (const auto& v : s.loops[0]) {
+      b.lo = b.lo.cwiseMin(vec<D>(v));
+      b.hi = b.hi.cwiseMax(vec<D>(v));
+    }
+    const double box = (b.hi - b.lo).prod();
+    b.fill = box > 0.0 ? std::min(1.0, geometry::loops_area(s.loops) / box) : 1.0;
   } else if (s.points) {  // points, volume_mesh
     // The particles' positions; fill 1 (the estimate then counts every lattice point there).
     for (int a = 0; a < D; ++a) {
