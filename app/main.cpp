@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cairn/fem/solver.hpp"
+#include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
 #include "cairn/io/schema.hpp"
@@ -37,9 +38,22 @@ void describe_setup(const cairn::Config& config) {
   for (int a = 0; a < D; ++a) cells += (a ? " x " : "") + std::to_string(g.n_cells()[a]);
   fmt::print("# grid: {} cells, {} stored nodes (ghost layers {})\n", cells, g.n_nodes(), g.ghost_layers());
   std::vector<std::size_t> per_body(config.bodies.size(), 0);
-  for (auto b : sim.particles().body) ++per_body[b];
-  for (std::size_t b = 0; b < per_body.size(); ++b)
-    fmt::print("# body '{}': {} particles\n", config.bodies[b].name, per_body[b]);
+  std::vector<std::size_t> with_volume(config.bodies.size(), 0);  // (not the WLS surface particles)
+  for (std::size_t p = 0; p < sim.particles().n(); ++p) {
+    ++per_body[sim.particles().body[p]];
+    with_volume[sim.particles().body[p]] += sim.particles().volume0[p] > 0.0;
+  }
+  for (std::size_t b = 0; b < per_body.size(); ++b) {
+    const auto& body = config.bodies[b];
+    if (!body.shape.mesh) {
+      fmt::print("# body '{}': {} particles\n", body.name, per_body[b]);
+      continue;
+    }
+    double v = 1.0;
+    for (int a = 0; a < D; ++a) v *= g.cell_size()[a] / body.particles_per_cell[static_cast<std::size_t>(a)];
+    fmt::print("# {}\n", cairn::geometry::volume_note(body.name, *body.shape.mesh,
+                                                      static_cast<long long>(with_volume[b]), v));
+  }
   fmt::print("# first time step: {:.6g}\n", sim.next_dt());
 }
 
@@ -76,6 +90,7 @@ void print_summary(const cairn::RunSummary& s) {
   if (s.ranks > 1)
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);
+  for (const auto& note : s.body_notes) fmt::print("cairn: {}\n", note);
   fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());
   double total = 0.0;

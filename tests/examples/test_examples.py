@@ -5,6 +5,7 @@ Usage: /usr/bin/python3 test_examples.py <cairn binary> <source dir>
 (two_blocks.toml and nickel_shock.toml are the verification cases two_blocks and nickel_shock.)
 """
 import csv
+import math
 import glob
 import os
 import re
@@ -133,6 +134,68 @@ def friction_block(cairn, source, out):
     check(lowest >= 0.02, f"friction_block: the block stays on the floor (lowest y {lowest:.4f} >= 0.02)")
 
 
+def meshed_projectile(cairn, source, out):
+    # The first 15 us of 30 us: through the first contact (at 7.5 us).
+    run(cairn, source, "meshed_projectile_3d.toml", out, ["simulation.end_time=1.5e-5", "output.every=5.0e-6"])
+    snaps = snapshots(out)
+    (t0, first), (t1, last) = snaps[0], snaps[-1]
+    # The mesh (examples/meshes/make_projectile.py): a 24-gon prism of circumradius 3 mm from
+    # z = 4 to 12 mm above the tip, on a 24-gon pyramid; translated to the tip at (12, 12, 8.5) mm.
+    # An inside test of our own (half-planes of the 24-gon, scaled in the nose) over the lattice of
+    # l = 0.5 mm must pick exactly the lattice points the mesh body holds.
+    n, r, nose, body, l = 24, 3e-3, 4e-3, 8e-3, 0.5e-3
+    k = np.arange(48)
+    X, Y, Z = np.meshgrid((k + 0.5) * l, (k + 0.5) * l, (np.arange(60) + 0.5) * l, indexing="ij")
+    h = Z - 0.0085
+    scale = np.clip(h / nose, 0.0, 1.0)
+    phi = (2 * np.arange(n) + 1) * math.pi / n
+    reach = np.max([(X - 0.012) * math.cos(a) + (Y - 0.012) * math.sin(a) for a in phi], axis=0)
+    inside = (h > 0) & (h < nose + body) & (reach < r * math.cos(math.pi / n) * scale)
+    count = int(inside.sum())
+    m = first["projectile"]["m"]
+    check(len(m) == count and abs(m.sum() - 7850.0 * count * l ** 3) <= 1e-12 * m.sum(),
+          f"meshed_projectile: {len(m)} particles of mass 7850 l^3, the lattice points inside the projectile "
+          f"by an independent test: {count}")
+    v_mesh = n / 2 * r * r * math.sin(2 * math.pi / n) * (body + nose / 3)
+    print(f"  (particle volume {count * l ** 3 * 1e9:.2f} mm^3, mesh volume {v_mesh * 1e9:.2f} mm^3)")
+    x = first["projectile"]["x"]
+    check(x[:, 2].min() > 0.0085 and x[:, 2].max() < 0.0205 and abs(x[:, 0].mean() - 0.012) < 1e-5
+          and abs(x[:, 1].mean() - 0.012) < 1e-5,
+          f"meshed_projectile: the projectile lies where units = mm and translate put it "
+          f"(z {x[:, 2].min():.4f}..{x[:, 2].max():.4f}, centre {x[:, 0].mean():.4f}, {x[:, 1].mean():.4f})")
+
+    def momentum(bodies):
+        return sum((b["m"] * b["v"][:, 2]).sum() for b in bodies.values())
+
+    p0, p1 = momentum(first), momentum(last)
+    check(abs(p1 - p0) <= 1e-3 * abs(p0), f"meshed_projectile: z momentum {p0:.6g} -> {p1:.6g} (no external force)")
+    vp, vq = mean_velocity(last["projectile"], 2), mean_velocity(last["plate"], 2)
+    check(vp > -190.0 and vq < -5.0,
+          f"meshed_projectile: at t = {t1 * 1e6:.0f} us the projectile slowed to {vp:.1f} m/s and pushed the plate to {vq:.1f} m/s")
+
+
+def plate_with_holes(cairn, source, out):
+    # The first 12 ms of 30 ms: the plate has hit the wall (at 5 ms) and been stopped.
+    run(cairn, source, "plate_with_holes_2d.toml", out, ["simulation.end_time=1.2e-2", "output.every=6.0e-3"])
+    snaps = snapshots(out)
+    (t0, first), (t1, last) = snaps[0], snaps[-1]
+    # The outline (examples/meshes/plate_with_holes.geo): 60 x 40 mm minus two holes of 8 mm, each
+    # hole a polygon of chords h <= 1 mm inside its circle (2 pi h^2 / 12 more area per hole).
+    h, r = 1e-3, 8e-3
+    area = 0.06 * 0.04 - 2 * math.pi * r * r
+    m = first["plate"]["m"].sum()
+    check(area * 1000.0 <= m <= (area + 2 * 2 * math.pi * h * h / 12) * 1000.0,
+          f"plate_with_holes: mass {m:.6g} kg = density x the meshed area ({area * 1000.0:.6g} kg for the exact outline)")
+    x = first["plate"]["x"]
+    in_holes = sum(int(np.hypot(x[:, 0] - cx, x[:, 1] - 0.03).min() < r * math.cos(math.pi / 8)) for cx in (0.025, 0.055))
+    check(in_holes == 0 and x[:, 0].min() > 0.01 and x[:, 0].max() < 0.07,
+          "plate_with_holes: the particles fill the outline and leave both holes empty")
+    vy = mean_velocity(last["plate"], 1)
+    lowest = min(b["plate"]["x"][:, 1].min() for _, b in snaps)
+    check(vy > -1.0 and lowest > -1e-3,
+          f"plate_with_holes: the wall stopped the plate (v_y {vy:.3f} m/s at t = {t1 * 1e3:.1f} ms, lowest y {lowest * 1e3:.2f} mm)")
+
+
 def tutorial(cairn, source, out):
     """docs/tutorial.md builds examples/disk_wall.toml block by block: its TOML blocks put
     together must resolve to the same input (the output folder aside)."""
@@ -160,7 +223,7 @@ def main():
     cairn, source = sys.argv[1], sys.argv[2]
     with tempfile.TemporaryDirectory(prefix="cairn_examples_") as tmp:
         try:
-            for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block):
+            for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block, meshed_projectile, plate_with_holes):
                 print(case.__name__)
                 case(cairn, source, os.path.join(tmp, case.__name__))
         except CheckFailed as e:

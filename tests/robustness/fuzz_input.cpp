@@ -49,11 +49,16 @@ void set_up(const cairn::Config& config) {
   (void)sim.next_dt();
 }
 
+/// The name an input is read under: files it names (meshes, pictures, point files) resolve
+/// against its folder, the first --corpus folder in the standalone driver (so that the examples'
+/// meshes/ are found).
+std::string input_name = "fuzz.toml";
+
 /// Run one input through the input layer: 1 when it set up a simulation, 0 for an input error,
 /// -1 (with `what`) when something else came out.
 int exercise(const std::string& text, std::string& what) {
   try {
-    const cairn::Config config = cairn::load_config_string(text, "fuzz.toml", limits);
+    const cairn::Config config = cairn::load_config_string(text, input_name, limits);
     switch (config.simulation.dimension) {
       case 1: set_up<1>(config); break;
       case 2: set_up<2>(config); break;
@@ -271,6 +276,7 @@ int main(int argc, char** argv) {
     }
   }
   const std::vector<std::string> corpus = read_corpus(folders);
+  if (!folders.empty()) input_name = folders.front() + "/fuzz.toml";
   if (corpus.empty()) {
     std::fprintf(stderr, "fuzz_input: no .toml seed in the --corpus folders\n");
     return 2;

@@ -65,6 +65,11 @@ TriangleMesh read_gmsh_file(const std::string& path) {
   return m;
 }
 
+ElementMesh read_gmsh_elements(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw std::invalid_argument("no such file");
+  return gmsh().read_elements(path);
+}
+
 TriangleMesh generate_gmsh(const FemConfig& fem) {
   TriangleMesh m = gmsh().generate(fem);
   // Gmsh orients the triangles by the surface normal; OpenCASCADE planar faces face +z, but

@@ -171,7 +171,65 @@ TriangleMesh generate(const FemConfig& fem) {
   return extract(source, "fem.shape");
 }
 
-const GmshModule module{gmsh_module_version, read_file, generate};
+ElementMesh read_elements(const std::string& path) {
+  GmshSession session;
+  ElementMesh m;
+  try {
+    gmsh::open(path);
+    // A .geo geometry without a mesh: mesh it (3D when it has volumes, else 2D).
+    std::vector<std::size_t> tags;
+    std::vector<double> coords, param;
+    gmsh::model::mesh::getNodes(tags, coords, param, -1, -1, false, false);
+    if (tags.empty()) gmsh::model::mesh::generate(gmsh::model::getDimension());
+  } catch (...) {
+    throw std::invalid_argument("Gmsh could not read or mesh it: " + current_error());
+  }
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, param;
+  gmsh::model::mesh::getNodes(node_tags, coords, param, -1, -1, false, false);
+  std::unordered_map<std::size_t, std::int32_t> index_of_tag;
+  for (std::size_t i = 0; i < node_tags.size(); ++i) {
+    index_of_tag[node_tags[i]] = static_cast<std::int32_t>(i);
+    m.nodes.push_back({coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]});
+  }
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> element_tags, element_nodes;
+  gmsh::model::mesh::getElements(types, element_tags, element_nodes, -1, -1);
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    std::string name;
+    int dim = 0, order = 0, n_nodes = 0, n_primary = 0;
+    std::vector<double> local;
+    gmsh::model::mesh::getElementProperties(types[k], name, dim, order, n_nodes, local, n_primary);
+    if (dim < 2) continue;
+    if (types[k] != 2 && types[k] != 4) {
+      if (m.other.empty())
+        m.other = fmt::format("{} elements of type {} ({}), e.g. element {}", element_tags[k].size(), types[k], name,
+                              element_tags[k].front());
+      continue;
+    }
+    const auto n = static_cast<std::size_t>(n_nodes);
+    for (std::size_t e = 0; e < element_tags[k].size(); ++e) {
+      std::array<std::int32_t, 4> c{};
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto it = index_of_tag.find(element_nodes[k][n * e + i]);
+        if (it == index_of_tag.end())
+          throw std::invalid_argument(fmt::format("element {} refers to missing node {}", element_tags[k][e],
+                                                  element_nodes[k][n * e + i]));
+        c[i] = it->second;
+      }
+      if (types[k] == 2) {
+        m.triangles.push_back({c[0], c[1], c[2]});
+        m.triangle_tags.push_back(element_tags[k][e]);
+      } else {
+        m.tetrahedra.push_back(c);
+        m.tetrahedron_tags.push_back(element_tags[k][e]);
+      }
+    }
+  }
+  return m;
+}
+
+const GmshModule module{gmsh_module_version, read_file, generate, read_elements};
 
 }  // namespace
 

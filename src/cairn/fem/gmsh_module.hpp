@@ -5,7 +5,10 @@
 // (docs/performance.md, "Start-up").
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cairn/fem/mesh.hpp"
 
@@ -13,7 +16,23 @@ namespace cairn::fem {
 
 /// Bumped whenever GmshModule or the types it passes change: a module of another version (a
 /// stale build) is refused.
-inline constexpr int gmsh_module_version = 1;
+inline constexpr int gmsh_module_version = 2;
+
+/// The elements of a .msh file for particles (geometry/volume_mesh.hpp): the nodes (x, y, z),
+/// the 3-node triangles and 4-node tetrahedra (node indices into `nodes`) with their Gmsh tags,
+/// and the first other element type of dimension 2 or 3 met ("" when none).
+struct ElementMesh {
+  std::vector<std::array<double, 3>> nodes;
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::vector<std::size_t> triangle_tags;
+  std::vector<std::array<std::int32_t, 4>> tetrahedra;
+  std::vector<std::size_t> tetrahedron_tags;
+  std::string other;
+};
+
+/// The elements of the .msh (or .geo, meshed) file `path`, read through the module. Throws
+/// std::invalid_argument naming the fault when Gmsh cannot read it.
+ElementMesh read_gmsh_elements(const std::string& path);
 
 /// What the module provides. Both functions throw InputError (or std::runtime_error) as the
 /// in-program code would; the meshes come back as Gmsh gave them (unchecked, unoriented).
@@ -21,6 +40,7 @@ struct GmshModule {
   int version;
   TriangleMesh (*read_file)(const std::string& path);  ///< a .msh file's 3-node triangles
   TriangleMesh (*generate)(const FemConfig& fem);       ///< fem.shape minus the hole, meshed
+  ElementMesh (*read_elements)(const std::string& path);  ///< triangles and tetrahedra of a file
 };
 
 }  // namespace cairn::fem

@@ -91,9 +91,13 @@ struct MaterialConfig {
 };
 
 struct GreyImage;  // io/image.hpp
+namespace geometry {
+class SurfaceMesh;  // geometry/surface_mesh.hpp
+struct PointSet;    // geometry/point_set.hpp
+}  // namespace geometry
 
 struct BodyShapeConfig {
-  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | image
+  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | cylinder | image | mesh | volume_mesh | points | outline
   std::vector<double> min, max;         ///< box
   std::vector<double> center;           ///< circle, ellipse, annulus, sphere, cylinder
   double radius = 0.0;                  ///< circle, sphere, cylinder
@@ -111,6 +115,20 @@ struct BodyShapeConfig {
   /// image: the pixels, read once by the loader and shared by bodies naming the same file;
   /// null when the Config was built in code (bodies.cpp then reads `file`).
   std::shared_ptr<const GreyImage> image;
+  /// mesh (3D): a closed triangle surface (STL, OBJ, PLY, OFF) in `file`, placed by x = R (s x_file) + t
+  /// with s = scale times the file's unit in the model's length unit, R the rotation by the Euler
+  /// angles `rotate` (degrees, about x, then y, then z) and t = `translate` (docs/geometry.md).
+  double scale = 1.0;
+  std::vector<double> rotate, translate;
+  std::string units;
+  /// mesh: the checked surface and its inside test, read by the loader (null in a Config built in code).
+  std::shared_ptr<const geometry::SurfaceMesh> mesh;
+  /// volume_mesh / points: particles given one by one (position, volume, optional fields), read by the
+  /// loader from a Gmsh mesh (`quadrature` points per element) or a CSV/HDF5 point file.
+  int quadrature = 1;
+  std::shared_ptr<const geometry::PointSet> points;
+  /// outline (2D): closed loops, the first the outside and the others holes (even-odd rule), from a file.
+  std::vector<std::vector<std::vector<double>>> loops;
 };
 
 struct BodyConfig {

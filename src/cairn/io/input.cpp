@@ -22,8 +22,13 @@
 #include <sstream>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/geometry/outline.hpp"
+#include "cairn/geometry/point_set.hpp"
+#include "cairn/geometry/surface_mesh.hpp"
+#include "cairn/geometry/volume_mesh.hpp"
 #include "cairn/io/image.hpp"
 #include "cairn/io/schema.hpp"
+#include "cairn/io/units.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/wls/arrangement.hpp"
 
@@ -385,6 +390,26 @@ class Loader {
   void read_bodies(const toml::table& root, Config& cfg);
   /// `earlier`: the bodies read so far (an image named again is shared, not read again).
   BodyShapeConfig read_shape(TableReader& body, const std::vector<BodyConfig>& earlier);
+  /// shape = { mesh = {...} }: reads and checks the surface (geometry/surface_mesh.hpp) once per
+  /// file and placement; shape = { volume_mesh = {...} }: the particles of a Gmsh mesh's elements.
+  void read_mesh_shape(TableReader& r, BodyShapeConfig& s, const std::vector<BodyConfig>& earlier);
+  /// file, units, scale, rotate, translate of a mesh shape (into `s`) as a placement.
+  geometry::MeshPlacement read_placement(TableReader& r, BodyShapeConfig& s);
+  /// The `file` key of a shape read from a file: non-empty, resolved against the input's folder.
+  std::string file_key(TableReader& r) {
+    const std::string file = r.string("file");
+    if (file.empty()) r.fail("file", r.given("file"), "a non-empty file name", "\"\"");
+    return resolve_input_relative(file, file_);
+  }
+  /// What `read` returns, its std::invalid_argument an input error at the `file` key.
+  template <class Read>
+  auto read_file_key(TableReader& r, const std::string& expected, Read&& read) -> decltype(read()) {
+    try {
+      return read();
+    } catch (const std::invalid_argument& e) {
+      r.fail("file", r.given("file"), expected + ", relative to the input file's directory", e.what());
+    }
+  }
   void read_boundary(const toml::table& root, Config& cfg);
   void read_body_force(const toml::table& root, Config& cfg);
   void read_thermal(const toml::table& root, Config& cfg);
@@ -414,6 +439,7 @@ class Loader {
   Constants constants_;  ///< [constants], for compiling expressions
   std::vector<std::string> warnings_;
   int dim_ = 0;
+  std::string length_unit_ = "m";  ///< the model's length unit (simulation.units), for mesh files' units
 };
 
 // ---- TableReader ---------------------------------------------------------------------------
@@ -902,6 +928,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.adapt_threads = r.boolean("adapt_threads");
   s.sort_particles = r.boolean("sort_particles");
   s.units = r.string("units");
+  length_unit_ = unit_symbol(s.units, Quantity::length);
   s.memory_limit = r.real("memory_limit");
   s.rebalance_threshold = r.real("rebalance_threshold");
   s.max_estimated_steps = r.real("max_estimated_steps");
@@ -1172,10 +1199,79 @@ BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConf
                e.what());
       }
     }
+  } else if (kind == "mesh" || kind == "volume_mesh") {
+    read_mesh_shape(r, s, earlier);
+  } else if (kind == "outline") {
+    s.file = file_key(r);
+    s.scale = r.real("scale");
+    s.translate = r.reals("translate", 2, false);
+    s.loops = read_file_key(r, "a CSV outline: lines \"x, y\", loops separated by blank lines, the first the "
+                               "outside and the others holes inside it, no two edges meeting (docs/geometry.md)",
+                            [&] { return geometry::read_outline_csv(s.file, s.scale, s.translate); });
+  } else if (kind == "points") {
+    s.file = file_key(r);
+    s.points = read_file_key(r, "a point file: CSV with a header row x, y(, z), volume[, vx, vy(, vz)][, temperature] "
+                                "and one row per particle, or HDF5 (.h5) with datasets position, volume[, velocity]"
+                                "[, temperature] (docs/geometry.md)",
+                             [&] { return geometry::read_point_file(s.file, dim_); });
   } else {
     throw std::logic_error("input: shape kind '" + kind + "' declared but not read");
   }
   return s;
+}
+
+geometry::MeshPlacement Loader::read_placement(TableReader& r, BodyShapeConfig& s) {
+  s.file = file_key(r);
+  s.units = r.string("units");
+  s.scale = r.real("scale");
+  s.rotate = r.reals("rotate", 3, false);
+  s.translate = r.reals("translate", 3, false);
+  if (dim_ == 2 && (s.rotate[0] != 0.0 || s.rotate[1] != 0.0))
+    r.fail("rotate", r.given("rotate"), "[0, 0, angle] in 2D (a turn about z)",
+           fmt::format("[{}, {}, {}]", s.rotate[0], s.rotate[1], s.rotate[2]));
+  if (dim_ == 2 && s.translate[2] != 0.0)
+    r.fail("translate", r.given("translate"), "[x, y, 0] in 2D",
+           fmt::format("[{}, {}, {}]", s.translate[0], s.translate[1], s.translate[2]));
+  geometry::MeshPlacement placement;
+  placement.scale = s.scale;
+  if (s.units != "model") {
+    double model = 0.0;
+    try {
+      model = geometry::unit_in_metres(length_unit_);
+    } catch (const std::invalid_argument&) {
+      r.fail("units", r.given("units"),
+             "\"model\" while simulation.units declares no length unit (or declare one, e.g. \"SI\")",
+             toml_string(s.units));
+    }
+    placement.scale *= geometry::unit_in_metres(s.units) / model;
+  }
+  for (std::size_t a = 0; a < 3; ++a) {
+    placement.rotate_degrees[a] = s.rotate[a];
+    placement.translate[a] = s.translate[a];
+  }
+  return placement;
+}
+
+void Loader::read_mesh_shape(TableReader& r, BodyShapeConfig& s, const std::vector<BodyConfig>& earlier) {
+  const geometry::MeshPlacement placement = read_placement(r, s);
+  if (s.kind == "volume_mesh") {
+    s.quadrature = static_cast<int>(r.integer("quadrature"));
+    s.points = read_file_key(r,
+                             "a Gmsh mesh of 3-node triangles (2D) or 4-node tetrahedra (3D), quadrature 1 or 3 "
+                             "(2D) / 4 (3D) (docs/geometry.md)",
+                             [&] { return geometry::read_volume_mesh(s.file, dim_, s.quadrature, placement); });
+    return;
+  }
+  for (const auto& other : earlier)
+    if (other.shape.mesh && other.shape.file == s.file && other.shape.units == s.units &&
+        other.shape.scale == s.scale && other.shape.rotate == s.rotate && other.shape.translate == s.translate)
+      s.mesh = other.shape.mesh;
+  if (s.mesh) return;
+  s.mesh = read_file_key(r,
+                         "a closed triangle surface without open edges, self-intersections or degenerate faces "
+                         "(docs/geometry.md)",
+                         [&] { return geometry::read_surface_mesh(s.file, placement); });
+  for (const auto& w : s.mesh->warnings()) warn(r.path_of("file"), r.given("file"), w);
 }
 
 void Loader::read_bodies(const toml::table& root, Config& cfg) {
@@ -1691,6 +1787,15 @@ std::string shape_text(const BodyShapeConfig& s) {
   else if (s.kind == "image")
     params = fmt::format("file = {}, pixel_size = {}, origin = {}, levels = [{}, {}]", toml_string(s.file),
                          real_text(s.pixel_size), reals_text(s.origin), s.level_min, s.level_max);
+  else if (s.kind == "outline")
+    params = fmt::format("file = {}, scale = {}, translate = {}", toml_string(s.file), real_text(s.scale),
+                         reals_text(s.translate));
+  else if (s.kind == "points")
+    params = fmt::format("file = {}", toml_string(s.file));
+  else if (s.kind == "mesh" || s.kind == "volume_mesh")
+    params = fmt::format("file = {}, {}units = {}, scale = {}, rotate = {}, translate = {}", toml_string(s.file),
+                         s.kind == "volume_mesh" ? fmt::format("quadrature = {}, ", s.quadrature) : "",
+                         toml_string(s.units), real_text(s.scale), reals_text(s.rotate), reals_text(s.translate));
   return fmt::format("{{ {} = {{ {} }} }}", toml_key(s.kind), params);
 }
 

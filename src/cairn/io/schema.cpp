@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <map>
 
+#include "cairn/geometry/shape_keys.hpp"
 #include "cairn/io/units.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/sim/names.hpp"
@@ -400,6 +401,8 @@ std::vector<KeyDecl> make_declarations() {
                 .required()
                 .min(0)
                 .max(255));
+  // Shapes read from files, declared beside their readers (geometry/shape_keys.cpp).
+  for (KeyDecl& d : geometry::shape_keys()) k.push_back(std::move(d));
 
   // [boundary]
   const char* faces[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
@@ -742,6 +745,11 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.polygon.vertices", "real[2][n]"},
       {"body.shape.image.origin", "real[2]"},
       {"body.shape.image.levels", "integer[2]"},
+      {"body.shape.mesh.rotate", "real[3]"},
+      {"body.shape.mesh.translate", "real[3]"},
+      {"body.shape.outline.translate", "real[2]"},
+      {"body.shape.volume_mesh.rotate", "real[3]"},
+      {"body.shape.volume_mesh.translate", "real[3]"},
       {"traction.table", "real[2][n]"},
       {"velocity.table", "real[2][n]"},
       {"wall.table", "real[2][n]"},
@@ -1094,7 +1102,23 @@ std::string markdown_text() {
           "```\n\n"
           "The picture is read once per file when the input is loaded (a missing or unreadable "
           "file is an input error at the `file` key); the resolved input (`cairn check`, "
-          "checkpoints) names it by its absolute path, so a restart needs the file still there.\n";
+          "checkpoints) names it by its absolute path, so a restart needs the file still there.\n"
+          "\nA `mesh` body (3D) is the inside of a closed triangle surface read from a file, placed by "
+          "x = R (scale x_file) + translate; the file is checked when the input is loaded (an open, "
+          "non-manifold, self-intersecting or degenerate surface is an input error at `file`, an "
+          "inward or inconsistent orientation is turned with a warning). Formats, the inside test, "
+          "limits and recipes from CAD tools are in docs/geometry.md:\n\n"
+          "```toml\n"
+          "[[body]]\n"
+          "material = \"steel\"\n"
+          "shape = { mesh = { file = \"part.stl\", units = \"mm\", rotate = [90.0, 0.0, 0.0], "
+          "translate = [0.1, 0.0, 0.05] } }\n"
+          "```\n\n"
+          "A `volume_mesh` body takes the 3-node triangles (2D) or 4-node tetrahedra (3D) of a Gmsh "
+          "mesh (a `.geo` outline, holes and all, is meshed when read): one particle per element or per "
+          "Gauss point, with its share of the element's area/volume, so the mass is density x mesh "
+          "volume exactly. A `points` body takes one particle per row of a CSV file (x, y, z, volume, "
+          "optional velocity and temperature).\n";
     }
   }
   return out;
@@ -1255,7 +1279,13 @@ const std::vector<BodyShapeKind>& body_shape_kinds() {
        "Pixels of a grey-level PNG picture whose level lies in a range (one body per "
        "material shade)."},
   };
-  return kinds;
+  static const std::vector<BodyShapeKind> all = [] {
+    std::vector<BodyShapeKind> out = kinds;
+    for (const auto& g : geometry::shape_kinds())
+      out.push_back({g.name, {g.valid_in[0], g.valid_in[1], g.valid_in[2]}, g.doc});
+    return out;
+  }();
+  return all;
 }
 
 std::vector<KeyDecl> material_keys(const std::string& model) {

@@ -16,6 +16,13 @@
 // (to 1e-6 pixel, so that rounding does not decide) belongs to the pixel on its +x / +y side:
 // lattices whose points fall on pixel corners sample the picture consistently.
 //
+// Shapes from files (docs/geometry.md): a mesh (3D) keeps X when X is inside its closed surface
+// (geometry/surface_mesh.hpp; the lattice is visited line by line along x, which is what the
+// surface's per-line memo is for); an outline (2D) by the even-odd rule over its loops, as a
+// polygon; volume_mesh and points replace the lattice by their own particles (geometry/
+// volume_mesh.hpp, point_set.hpp), each with its own volume and a domain of a square/cube of that
+// volume, a point file's velocities and temperatures replacing the body's.
+//
 // Only the lattice points inside the shape's bounds are visited (sim/resources.hpp), in the same
 // order as a sweep of the whole grid would visit them. A shape reaching past the grid is an error
 // unless the body says clip = true; bodies sharing space (a particle of one inside another's
@@ -29,6 +36,9 @@
 #include <stdexcept>
 
 #include "cairn/bc/expression.hpp"
+#include "cairn/geometry/outline.hpp"
+#include "cairn/geometry/point_set.hpp"
+#include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/image.hpp"
 #include "cairn/parallel/comm.hpp"
@@ -39,8 +49,9 @@
 namespace cairn {
 namespace {
 
+/// `line`: the memo of a mesh shape's inside test (geometry/surface_mesh.hpp), one per body.
 template <int D>
-bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
+bool inside(const BodyShapeConfig& s, const GreyImage* image, geometry::LineCache& line, const Vec<D>& x) {
   auto vec = [](const std::vector<double>& v) {
     Vec<D> out = Vec<D>::Zero();
     for (int a = 0; a < D && a < static_cast<int>(v.size()); ++a) out[a] = v[a];
@@ -67,16 +78,13 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, const Vec<D>& x) {
     return r >= s.inner_radius && r <= s.outer_radius;
   }
   if (s.kind == "polygon") {
-    if constexpr (D == 2) {
-      bool in = false;  // even-odd crossing rule
-      const auto& v = s.vertices;
-      for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
-        if ((v[i][1] > x[1]) != (v[j][1] > x[1]) &&
-            x[0] < (v[j][0] - v[i][0]) * (x[1] - v[i][1]) / (v[j][1] - v[i][1]) + v[i][0])
-          in = !in;
-      }
-      return in;
-    }
+    if constexpr (D == 2) return geometry::inside_loop(s.vertices, x[0], x[1]);  // even-odd crossing rule
+  }
+  if (s.kind == "outline") {
+    if constexpr (D == 2) return geometry::inside_loops(s.loops, x[0], x[1]);  // holes by the same rule
+  }
+  if (s.kind == "mesh" && s.mesh) {
+    if constexpr (D == 3) return s.mesh->inside(x[0], x[1], x[2], line);
   }
   if (s.kind == "image" && image) {
     if constexpr (D == 2) {
@@ -136,6 +144,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
   std::vector<std::vector<std::size_t>> shared(n_bodies, std::vector<std::size_t>(n_bodies, 0));
   std::vector<ShapeBounds<D>> bounds_of;
   std::vector<std::shared_ptr<const GreyImage>> image_of;
+  std::vector<geometry::LineCache> line_of(n_bodies);
   for (std::size_t b = 0; b < config.bodies.size(); ++b) {
     const BodyConfig& body = config.bodies[b];
     int mat = -1;
@@ -192,14 +201,22 @@ void create_particles(const Config& config, const Grid<D>& grid,
     // The lattice, or the seed 001 Fig. 4b rings/shells; WLS adds surface particles (zero volume)
     // between lattice points in and out of the shape, on a lattice one point wider than the box.
     const bool radial = body.arrangement == "radial";
-    const bool surface = config.method.integration == "wls";
+    // A point file: its rows are the particles, with their own volumes (geometry/point_set.hpp).
+    const geometry::PointSet* points = body.shape.points.get();  // (points, volume_mesh)
+    const bool surface = config.method.integration == "wls" && !points;
     std::vector<wls::Seed<D>> seeds;
-    if (radial) {
+    if (points) {
+      for (std::size_t i = 0; i < points->n(); ++i) {
+        Vec<D> X;
+        for (int a = 0; a < D; ++a) X[a] = points->position[i][static_cast<std::size_t>(a)];
+        seeds.push_back({X, points->volume[i]});
+      }
+    } else if (radial) {
       for (auto& s : wls::radial_arrangement<D>(body.shape, lp.minCoeff(), surface))
         if ((s.X.array() >= grid.origin().array()).all() && (s.X.array() < grid.extent_max().array()).all())
           seeds.push_back(s);
     } else if (surface && total > 0) {
-      auto in = [&](const Vec<D>& X) { return inside<D>(body.shape, image.get(), X); };
+      auto in = [&](const Vec<D>& X) { return inside<D>(body.shape, image.get(), line_of[b], X); };
       Vec<D> first;
       IVec<D> count;
       for (int a = 0; a < D; ++a) {
@@ -210,7 +227,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
       }
       for (const Vec<D>& X : wls::lattice_surface_points<D>(in, first, lp, count)) seeds.push_back({X, 0.0});
     }
-    const long long n_lattice = radial ? 0 : total;
+    const long long n_lattice = radial || points ? 0 : total;
     for (long long k = 0; k < n_lattice + static_cast<long long>(seeds.size()); ++k) {
       Vec<D> X;
       double particle_volume = vol, particle_mass = mass;
@@ -221,7 +238,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
           rem /= span[a];
           X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
         }
-        if (!inside<D>(body.shape, image.get(), X)) continue;
+        if (!inside<D>(body.shape, image.get(), line_of[b], X)) continue;
       } else {
         const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
         X = s.X;
@@ -231,17 +248,26 @@ void create_particles(const Config& config, const Grid<D>& grid,
       // (zero-volume particles carry no mass: they make no overlap)
       if (particle_volume > 0.0)
         for (std::size_t a : near_bodies)
-          if (inside<D>(config.bodies[a].shape, image_of[a].get(), X)) ++shared[b][a];
+          if (inside<D>(config.bodies[a].shape, image_of[a].get(), line_of[a], X)) ++shared[b][a];
       ++count_of[b];
       const std::int64_t id = next_id++;
       const Vec<D> x = displacement ? Vec<D>(X + (*displacement)(X, X, 0.0)) : X;
       if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x)) continue;
-      const Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
-      particles.add(X, v0, particle_mass, particle_volume, lp, mat, static_cast<std::int32_t>(b));
+      Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
+      Vec<D> domain = lp;  // a point file's particle: a cube (square) of its own volume (area)
+      const std::size_t row = static_cast<std::size_t>(k - n_lattice);
+      if (points) {
+        domain = Vec<D>::Constant(std::pow(points->volume[row], 1.0 / D));
+        if (!points->velocity.empty())
+          for (int a = 0; a < D; ++a) v0[a] = points->velocity[row][static_cast<std::size_t>(a)];
+      }
+      particles.add(X, v0, particle_mass, particle_volume, domain, mat, static_cast<std::int32_t>(b));
       particles.id.back() = id;
       {
         const std::size_t p = particles.n() - 1;
-        if (particles.has_temperature) particles.temperature[p] = materials[mat]->initial_temperature();
+        if (particles.has_temperature)
+          particles.temperature[p] = points && !points->temperature.empty() ? points->temperature[row]
+                                                                             : materials[mat]->initial_temperature();
         if (particles.n_state_per_particle > 0)
           materials[mat]->initialize_state(&particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]);
       }

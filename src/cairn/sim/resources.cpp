@@ -11,6 +11,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "cairn/geometry/outline.hpp"
+#include "cairn/geometry/point_set.hpp"
+#include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/image.hpp"
 #include "cairn/sim/simulation.hpp"
@@ -113,6 +116,27 @@ ShapeBounds<D> shape_bounds(const BodyShapeConfig& s, const GreyImage* image, co
     b.hi[D - 1] = o[D - 1] + (image->height - r0) * px;
     if (in_level > 0)
       b.fill = static_cast<double>(in_level) / (static_cast<double>(c1 - c0 + 1) * (r1 - r0 + 1));
+  } else if (s.kind == "outline" && D == 2 && !s.loops.empty()) {
+    b.lo = b.hi = vec<D>(s.loops[0][0]);
+    for (const auto& v : s.loops[0]) {
+      b.lo = b.lo.cwiseMin(vec<D>(v));
+      b.hi = b.hi.cwiseMax(vec<D>(v));
+    }
+    const double box = (b.hi - b.lo).prod();
+    b.fill = box > 0.0 ? std::min(1.0, geometry::loops_area(s.loops) / box) : 1.0;
+  } else if (s.points) {  // points, volume_mesh
+    // The particles' positions; fill 1 (the estimate then counts every lattice point there).
+    for (int a = 0; a < D; ++a) {
+      b.lo[a] = s.points->lo[static_cast<std::size_t>(a)];
+      b.hi[a] = s.points->hi[static_cast<std::size_t>(a)];
+    }
+  } else if (s.kind == "mesh" && D == 3 && s.mesh) {
+    for (int a = 0; a < D; ++a) {
+      b.lo[a] = s.mesh->lo()[static_cast<std::size_t>(a)];
+      b.hi[a] = s.mesh->hi()[static_cast<std::size_t>(a)];
+    }
+    const double box = (b.hi - b.lo).prod();
+    b.fill = box > 0.0 ? std::min(1.0, s.mesh->volume() / box) : 1.0;
   } else {
     // A kind without known bounds: the whole grid (generation then visits every lattice point).
     b.lo = grid.origin();

@@ -17,6 +17,7 @@
 #include "cairn/bc/expression.hpp"
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/run.hpp"
+#include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/history.hpp"
@@ -208,6 +209,24 @@ class Runner {
     restarted_ = true;
   }
 
+  /// Bodies filled from surface meshes: the volume of their particles (over every rank; the
+  /// zero-volume WLS surface particles not counted) beside the mesh's own volume.
+  std::vector<std::string> mesh_volume_notes() const {
+    std::vector<std::string> notes;
+    const auto& P = sim_.particles();
+    for (std::size_t b = 0; b < config_.bodies.size(); ++b) {
+      const BodyConfig& body = config_.bodies[b];
+      if (!body.shape.mesh) continue;
+      std::int64_t n = 0;
+      for (std::size_t p = 0; p < P.n(); ++p)  // (outside a step every local particle is owned)
+        n += static_cast<std::size_t>(P.body[p]) == b && P.volume0[p] > 0.0;
+      double v = 1.0;
+      for (int a = 0; a < D; ++a) v *= sim_.grid().cell_size()[a] / body.particles_per_cell[static_cast<std::size_t>(a)];
+      notes.push_back(geometry::volume_note(body.name, *body.shape.mesh, comm_.sum(n), v));
+    }
+    return notes;
+  }
+
   RunSummary run() {
     const StopSignals signals;
     const auto start = Clock::now();
@@ -267,6 +286,7 @@ class Runner {
     summary.end_time = sim_.time();
     summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     summary.n_particles = static_cast<std::size_t>(n_particles_);
+    summary.body_notes = mesh_volume_notes();
     summary.ranks = comm_.size();
     summary.partitions = sim_.distribution().partitions();
     summary.migrated = comm_.sum(sim_.distribution().received());

@@ -39,6 +39,8 @@ struct RunSummary {
   /// corrections (inside the stages above), and contact nodes summed over the steps.
   double contact_prepare_seconds = 0.0, contact_fit_seconds = 0.0, contact_correct_seconds = 0.0;
   long long contact_node_steps = 0;
+  /// Bodies filled from surface meshes: particle volume beside mesh volume (geometry::volume_note).
+  std::vector<std::string> body_notes;
 };
 
 /// A run stopped by a SimulationFailure, with the step and time at which it happened. The last

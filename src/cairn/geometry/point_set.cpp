@@ -1,0 +1,180 @@
+// CSV point files as bodies (point_set.hpp).
+#include "cairn/geometry/point_set.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <filesystem>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "cairn/geometry/text.hpp"
+
+#include "cairn/io/hdf5_util.hpp"
+
+namespace cairn::geometry {
+
+namespace {
+
+std::vector<std::string> fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    out.push_back(trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+void add_bounds(PointSet& set, const std::array<double, 3>& x) {
+  for (std::size_t a = 0; a < static_cast<std::size_t>(set.dimension); ++a) {
+    set.lo[a] = std::min(set.lo[a], x[a]);
+    set.hi[a] = std::max(set.hi[a], x[a]);
+  }
+}
+
+std::shared_ptr<const PointSet> read_point_h5(const std::string& path, int dimension) {
+  auto fail = [&](const std::string& what) {
+    throw std::invalid_argument(fmt::format("point file '{}': {}", path, what));
+  };
+  auto set = std::make_shared<PointSet>();
+  set->file = path;
+  set->dimension = dimension;
+  for (auto& v : set->lo) v = std::numeric_limits<double>::infinity();
+  for (auto& v : set->hi) v = -std::numeric_limits<double>::infinity();
+  const auto d = static_cast<std::size_t>(dimension);
+  try {
+    const h5::Handle file = h5::open_file(path);
+    const hid_t root = file.get();
+    auto has = [&](const char* name) { return H5Lexists(root, name, H5P_DEFAULT) > 0; };
+    for (const char* need : {"position", "volume"})
+      if (!has(need)) fail(fmt::format("no dataset '{}' (datasets: position n x {}, volume n; optional velocity, "
+                                       "temperature)",
+                                       need, dimension));
+    const auto shape = h5::dataset_shape(root, "position");
+    if (shape.size() != 2 || shape[1] != d || shape[0] == 0)
+      fail(fmt::format("dataset 'position' of shape [{}], not n x {} with n > 0", fmt::join(shape, ", "), dimension));
+    const std::size_t n = shape[0];
+    auto read = [&](const char* name, std::size_t cols) {
+      const std::vector<double> v =
+          h5::read_doubles(root, name, cols ? std::vector<std::size_t>{n, cols} : std::vector<std::size_t>{n});
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (!std::isfinite(v[i])) fail(fmt::format("dataset '{}', entry {}: not a finite number", name, i));
+      return v;
+    };
+    const std::vector<double> position = read("position", d), volume = read("volume", 0);
+    const std::vector<double> velocity = has("velocity") ? read("velocity", d) : std::vector<double>{};
+    const std::vector<double> temperature = has("temperature") ? read("temperature", 0) : std::vector<double>{};
+    for (std::size_t i = 0; i < n; ++i) {
+      std::array<double, 3> x{0.0, 0.0, 0.0};
+      for (std::size_t a = 0; a < d; ++a) x[a] = position[i * d + a];
+      if (!(volume[i] > 0.0)) fail(fmt::format("dataset 'volume', entry {}: {} is not above zero", i, volume[i]));
+      add_bounds(*set, x);
+      set->position.push_back(x);
+      set->volume.push_back(volume[i]);
+      set->total_volume += volume[i];
+      if (!velocity.empty()) {
+        std::array<double, 3> v{0.0, 0.0, 0.0};
+        for (std::size_t a = 0; a < d; ++a) v[a] = velocity[i * d + a];
+        set->velocity.push_back(v);
+      }
+      if (!temperature.empty()) set->temperature.push_back(temperature[i]);
+    }
+  } catch (const std::runtime_error& e) {  // HDF5 failures (h5:: helpers)
+    fail(e.what());
+  }
+  return set;
+}
+
+std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dimension) {
+  auto fail = [&](long line, const std::string& what) -> void {
+    throw std::invalid_argument(line > 0 ? fmt::format("point file '{}', line {}: {}", path, line, what)
+                                         : fmt::format("point file '{}': {}", path, what));
+  };
+  std::ifstream in(path);
+  if (!in) fail(0, "cannot open it");
+  auto set = std::make_shared<PointSet>();
+  set->file = path;
+  set->dimension = dimension;
+  const std::vector<std::string> axes{"x", "y", "z"};
+  std::vector<std::string> allowed(axes.begin(), axes.begin() + dimension);
+  allowed.push_back("volume");
+  for (int a = 0; a < dimension; ++a) allowed.push_back("v" + axes[static_cast<std::size_t>(a)]);
+  allowed.push_back("temperature");
+  std::map<std::string, std::size_t> column;
+  std::size_t n_columns = 0;
+  std::string line;
+  long number = 0;
+  for (auto& v : set->lo) v = std::numeric_limits<double>::infinity();
+  for (auto& v : set->hi) v = -std::numeric_limits<double>::infinity();
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string t = trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    const std::vector<std::string> f = fields(t);
+    if (column.empty()) {
+      for (std::size_t i = 0; i < f.size(); ++i) {
+        if (std::find(allowed.begin(), allowed.end(), f[i]) == allowed.end())
+          fail(number, fmt::format("unknown column '{}' in the header (columns in {}D: {})", f[i], dimension,
+                                   fmt::join(allowed, ", ")));
+        if (!column.emplace(f[i], i).second) fail(number, fmt::format("column '{}' twice in the header", f[i]));
+      }
+      for (int a = 0; a <= dimension; ++a) {
+        const std::string& need = a < dimension ? axes[static_cast<std::size_t>(a)] : "volume";
+        if (!column.count(need)) fail(number, fmt::format("the header has no column '{}'", need));
+      }
+      int velocities = 0;
+      for (int a = 0; a < dimension; ++a) velocities += column.count("v" + axes[static_cast<std::size_t>(a)]) ? 1 : 0;
+      if (velocities != 0 && velocities != dimension)
+        fail(number, fmt::format("{} of the {} velocity columns (all or none)", velocities, dimension));
+      n_columns = f.size();
+      continue;
+    }
+    if (f.size() != n_columns) fail(number, fmt::format("{} fields, the header has {}", f.size(), n_columns));
+    auto value = [&](const std::string& name) {
+      const std::string& text = f[column.at(name)];
+      double v = 0.0;
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+      if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
+        fail(number, fmt::format("column '{}': '{}' is not a finite number", name, text));
+      return v;
+    };
+    std::array<double, 3> x{0.0, 0.0, 0.0};
+    for (int a = 0; a < dimension; ++a) x[static_cast<std::size_t>(a)] = value(axes[static_cast<std::size_t>(a)]);
+    add_bounds(*set, x);
+    const double vol = value("volume");
+    if (!(vol > 0.0)) fail(number, fmt::format("volume {} is not above zero", vol));
+    set->position.push_back(x);
+    set->volume.push_back(vol);
+    set->total_volume += vol;
+    if (column.count("vx")) {
+      std::array<double, 3> v{0.0, 0.0, 0.0};
+      for (int a = 0; a < dimension; ++a) v[static_cast<std::size_t>(a)] = value("v" + axes[static_cast<std::size_t>(a)]);
+      set->velocity.push_back(v);
+    }
+    if (column.count("temperature")) set->temperature.push_back(value("temperature"));
+  }
+  if (column.empty()) fail(0, "no header row (an empty file?)");
+  if (set->position.empty()) fail(0, "a header but no particle rows");
+  return set;
+}
+
+}  // namespace
+
+std::shared_ptr<const PointSet> read_point_file(const std::string& path, int dimension) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".h5" || ext == ".hdf5" ? read_point_h5(path, dimension) : read_point_csv(path, dimension);
+}
+
+}  // namespace cairn::geometry
