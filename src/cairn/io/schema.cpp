@@ -705,6 +705,13 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("0")
                 .min(0)
                 .max(9));
+  k.push_back(Key("output", "existing", T::string,
+                 "What a new run (not a restart) does with the numbered files an earlier run left in "
+                 "its folder (snapshots/particles-*.h5, checkpoint-*.h5, checkpoint-autosave.h5, "
+                 "failure files): remove = delete them first, saying how many (the new run writes its "
+                 "own); keep = leave them beside the new ones; error = refuse to run (exit 2).")
+                .by_default("\"remove\"")
+                .choices([] { return std::vector<std::string>{"remove", "keep", "error"}; }));
   return k;
 }
 
