@@ -361,6 +361,13 @@ def check_estimates(cairn, tmp):
           "and its wave speed as faster than any solid's")
 
 
+def keys_explain_seeds(cairn, tmp):
+    text = " ".join(cairn_run(cairn, ["keys"]).stdout.split())
+    header = text.split("[simulation]")[0]
+    check("seed 001 = Wallstedt and Guilkey" in header and "seed 001 Eq. 34" in text,
+          "cairn keys says what the \"seed 001\" its keys cite is")
+
+
 def main():
     if len(sys.argv) < 3:
         print("usage: test_cli.py <cairn binary> <source dir>", file=sys.stderr)
@@ -370,7 +377,7 @@ def main():
         try:
             for case in (usage_and_exit_codes, gmsh_loaded_on_demand, progress_bar, interrupts, wall_clock_checkpoints,
                          relative_folders_and_restarts, orphan_temporaries, thread_binding, input_errors_at_once,
-                         restart_keys, earlier_outputs, check_estimates):
+                         restart_keys, earlier_outputs, check_estimates, keys_explain_seeds):
                 print(case.__name__)
                 case(cairn, tmp)
         except (CheckFailed, subprocess.TimeoutExpired) as e:

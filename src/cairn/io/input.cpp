@@ -260,13 +260,10 @@ std::vector<KeyDecl> copy_section(std::string_view section) {
 /// " ('cfl' is a key of [simulation]: did you mean simulation.cfl?)", or "" when nowhere else.
 std::string declared_elsewhere(const Path& path, const std::string& key) {
   std::vector<std::string> places;
-  std::string first_section;
   for (const auto& d : declared_keys())
     if (d.name == key && d.section != path[0] && d.section.find('.') == std::string::npos &&
-        std::find(places.begin(), places.end(), d.section) == places.end()) {
-      if (first_section.empty()) first_section = d.section;
+        std::find(places.begin(), places.end(), d.section) == places.end())
       places.push_back(d.section);
-    }
   std::vector<std::string> models;  // a material model's own key
   for (const auto& [model, info] : material_model_info())
     for (const auto& d : info.keys)

@@ -986,6 +986,16 @@ std::vector<KeyDecl> copy_section(std::string_view section) {
   return out;
 }
 
+/// The source papers that docs cite as "seed 00N" (README.md, "seed" table), for the headers of
+/// `cairn keys` and docs/input.md.
+constexpr const char* seeds_cited =
+    "Docs cite the five source papers as \"seed 00N\" (README.md lists them): seed 000 = Nairn and "
+    "Hammerquist, full mass matrix MPM (FMPM, XPIC, boundary conditions); seed 001 = Wallstedt and "
+    "Guilkey, weighted least squares PIC (WLS); seed 002 = Nairn, notes on MPM extrapolations "
+    "(particle updates); seed 003 = Steffen, Wallstedt, Guilkey, Kirby and Berzins, MPM "
+    "implementation choices (shape functions, time integration); seed 004 = Nairn, Hammerquist and "
+    "Smith, MPM contact algorithms.";
+
 std::string markdown_text() {
   std::string out;
   out +=
@@ -998,7 +1008,12 @@ std::string markdown_text() {
       "default, allowed range or choices and a one-line doc; this page is generated from those "
       "declarations. Unknown keys, misspelled sections, values of the wrong type or out of "
       "range are errors that name the file, the line and the key, what was expected and what "
-      "was found.\n"
+      "was found; every independent error of a file is reported in one run (up to 20), and a "
+      "key written in the wrong section says which section declares it.\n"
+      "\n";
+  out += seeds_cited;
+  out +=
+      "\n"
       "\n"
       "- `D` is `simulation.dimension`; `real[D]` is an array with one number per axis.\n"
       "- Integers are accepted wherever a real is expected.\n"
@@ -1188,6 +1203,8 @@ std::string plain_text() {
       "reference.\n"
       "Override any key with --set section.key=value; [[material]] and [[body]] entries by\n"
       "index: --set material.0.density=1100\n";
+  for (const auto& line : wrap(seeds_cited, plain_width))
+    out += line + "\n";
   for (const auto& s : section_docs()) {
     out += fmt::format("\n{}\n", s.heading);
     if (s.name == "constants") {
