@@ -421,9 +421,10 @@ class Loader {
   void apply_override(toml::table& root, const std::string& text);
   /// One reading of the whole (overridden) tree; throws at its first error.
   Config read_all(const toml::table& root);
-  /// Every top-level entry that is not a section and every key that its table does not declare,
-  /// recorded in `errors` and removed from the tree, so that the reading goes on past them. False
-  /// when a section has the wrong form ([material] for [[material]]): nothing more is readable.
+  /// Every key that its table does not declare, recorded in `errors` and removed from the tree,
+  /// so that the reading goes on past them; also every top-level entry that is not a section, or
+  /// not of its form: then it returns false (what it holds is missing where it belongs, so the
+  /// rest is not read).
   bool remove_undeclared(toml::table& root, std::vector<InputError>& errors) const;
   /// After an error at `failed_path_`: the key to take out of the tree so that reading can go on
   /// past it with the key's default (an undeclared key, or a declared one with a default), or
@@ -1709,8 +1710,12 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
     }
   }
   if (errors.size() == 1) throw errors.front();
+  // In file order: the --set errors first, those without a line (a missing section) last.
+  const auto order = [](const InputError& e) {
+    return e.file().rfind("--set ", 0) == 0 ? -1 : e.line() > 0 ? e.line() : INT_MAX;
+  };
   std::stable_sort(errors.begin(), errors.end(),
-                   [](const InputError& a, const InputError& b) { return a.line() < b.line(); });
+                   [&](const InputError& a, const InputError& b) { return order(a) < order(b); });
   const bool truncated = errors.size() >= InputErrors::max_reported;
   if (truncated) errors.erase(errors.begin() + static_cast<std::ptrdiff_t>(InputErrors::max_reported), errors.end());
   throw InputErrors(std::move(errors), truncated);
@@ -1718,7 +1723,6 @@ Config Loader::load(toml::table& root, const std::vector<std::string>& overrides
 
 bool Loader::remove_undeclared(toml::table& root, std::vector<InputError>& errors) const {
   bool readable = true;
-  const auto& sections = section_names();
   // Takes every key that `decls` do not declare out of `table` (at `path`, named `what`).
   auto scan = [&](toml::table& table, const Path& path, const std::vector<KeyDecl>& decls, const std::string& what) {
     for (const auto& [key, node] : entries_in_file_order(table))
@@ -1732,9 +1736,10 @@ bool Loader::remove_undeclared(toml::table& root, std::vector<InputError>& error
     try {
       check_top_level_entry(key, *node);
     } catch (const InputError& e) {
+      // A misspelt section or a key above its section's header: the keys it holds are missing
+      // from where they belong, and reading on would only report that again.
       errors.push_back(e);
-      if (std::find(sections.begin(), sections.end(), key) == sections.end()) root.erase(key);
-      else readable = false;  // a section of the wrong form
+      readable = false;
       continue;
     }
     if (key == "constants") continue;  // a free table
