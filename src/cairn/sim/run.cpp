@@ -636,9 +636,9 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
   if (data.time >= end * (1.0 - 1e-12))
     throw InputError(file.string(), 0, "simulation.end_time",
                      fmt::format("an end time after the checkpoint's t = {:.6g} to continue to", data.time),
-                     fmt::format("{:.6g}, where this run finished; to go on, raise it: cairn restart {} --set "
-                                 "simulation.end_time={:.6g}",
-                                 end, file.string(), 2.0 * end));
+                     fmt::format("{0:.6g}, where this run finished; to go on, raise it: cairn restart {1} --set "
+                                 "simulation.end_time=<a time after {0:.6g}>",
+                                 end, file.string()));
   refuse_wls_on_ranks(config, file.string());
   // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints
   // them (rank 0 alone on several ranks).
