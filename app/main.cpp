@@ -11,6 +11,8 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <new>
@@ -21,6 +23,8 @@
 #include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/io/errors.hpp"
 #include "cairn/io/input.hpp"
+#include "cairn/io/plausibility.hpp"
+#include "cairn/io/units.hpp"
 #include "cairn/io/schema.hpp"
 #include "cairn/parallel/comm.hpp"
 #include "cairn/sim/run.hpp"
@@ -29,6 +33,70 @@
 #include "cairn/util/registry.hpp"
 
 namespace {
+
+/// "1 h 02 min", "3 min 20 s", "4.2 s".
+std::string wall_text(double seconds) {
+  const long long s = std::llround(seconds);
+  if (s >= 3600) return fmt::format("{} h {:02d} min", s / 3600, (s % 3600) / 60);
+  if (s >= 60) return fmt::format("{} min {:02d} s", s / 60, s % 60);
+  return fmt::format("{:.2g} s", seconds);
+}
+
+/// What sets the time step: per material its wave speed and the step it alone would allow
+/// (dt = cfl h / (c + max|v|), seed 001 Eq. 34), the estimated number of steps, and the wall
+/// time they would take, from a few steps timed here (a copy of the state: the check writes
+/// nothing). The estimate assumes the first step throughout; the adaptive step follows the
+/// deformation and the velocities.
+template <int D>
+void describe_time_step(cairn::Simulation<D>& sim, double dt) {
+  const cairn::Config& config = sim.config();
+  const auto& s = config.simulation;
+  const std::string speed = cairn::unit_symbol(s.units, cairn::Quantity::velocity);
+  const std::string time = cairn::unit_symbol(s.units, cairn::Quantity::time);
+  const double h = sim.grid().min_cell_size();
+  double v = 0.0;
+  std::vector<char> used(sim.materials().size(), 0);
+  for (std::size_t p = 0; p < sim.particles().n(); ++p) {
+    v = std::max(v, sim.particles().velocity[p].norm());
+    used[static_cast<std::size_t>(sim.particles().material[p])] = 1;
+  }
+  std::vector<double> c(sim.materials().size(), 0.0);
+  for (std::size_t m = 0; m < c.size(); ++m) c[m] = sim.materials()[m]->wave_speed(cairn::Mat3::Identity());
+  std::size_t fastest = c.size();
+  for (std::size_t m = 0; m < c.size(); ++m)
+    if (used[m] && (fastest == c.size() || c[m] > c[fastest])) fastest = m;
+  for (std::size_t m = 0; m < c.size(); ++m) {
+    std::string role = !used[m] ? " (no particles)" : "";
+    if (m == fastest) role = s.fixed_dt > 0.0 ? " (fastest; simulation.dt sets the step)" : " (fastest: sets the time step)";
+    fmt::print("# material '{}': wave speed {:.4g} {}, step limit cfl h / (c + max|v|) = {:.4g} {}{}\n",
+               config.materials[m].name, c[m], speed, s.cfl * h / (c[m] + v), time, role);
+  }
+  if (!(dt > 0.0) || !std::isfinite(dt)) return;
+  const double by_time = std::ceil(s.end_time / dt * (1.0 - 1e-12));
+  const double steps = s.max_steps > 0 ? std::min(by_time, static_cast<double>(s.max_steps)) : by_time;
+  fmt::print("# estimated steps: {:.6g} (end_time {:.6g} / first time step{})\n", steps, s.end_time,
+             s.max_steps > 0 && steps < by_time ? ", bounded by simulation.max_steps" : "");
+  // Calibration: up to 20 steps or about half a second of wall time.
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  int timed = 0;
+  double seconds = 0.0;
+  try {
+    while (timed < 20 && seconds < 0.5 && timed < steps) {
+      sim.step(sim.next_dt());
+      ++timed;
+      seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    }
+  } catch (const std::exception& e) {
+    fmt::print("# wall time estimate: none (calibration step {} failed: {})\n", timed + 1, e.what());
+    return;
+  }
+  if (timed == 0) return;
+  const int threads = omp_get_max_threads();
+  fmt::print("# wall time estimate: {} ({:.3g} s per step over {} timed step{}, {} thread{}; cairn run -t N changes it)\n",
+             wall_text(seconds / timed * steps), seconds / timed, timed, timed == 1 ? "" : "s", threads,
+             threads == 1 ? "" : "s");
+}
 
 template <int D>
 void describe_setup(const cairn::Config& config) {
@@ -54,7 +122,9 @@ void describe_setup(const cairn::Config& config) {
     fmt::print("# {}\n", cairn::geometry::volume_note(body.name, *body.shape.mesh,
                                                       static_cast<long long>(with_volume[b]), v));
   }
-  fmt::print("# first time step: {:.6g}\n", sim.next_dt());
+  const double dt = sim.next_dt();
+  fmt::print("# first time step: {:.6g}\n", dt);
+  describe_time_step(sim, dt);
 }
 
 void describe(const cairn::Config& config) {
@@ -117,6 +187,18 @@ constexpr const char* usage =
     "       cairn restart CHECKPOINT.h5 [--set section.key=value]... [-q] [-t THREADS]\n"
     "       cairn keys [--markdown]\n"
     "       cairn --help | --version\n";
+
+/// One line per error of the input, then how many there were when more than one.
+void print_input_errors(std::ostream& err, const cairn::InputError& e) {
+  const auto* all = dynamic_cast<const cairn::InputErrors*>(&e);
+  if (!all) {
+    err << "cairn: input error: " << e.what() << "\n";
+    return;
+  }
+  for (const auto& one : all->errors()) err << "cairn: input error: " << one.what() << "\n";
+  err << fmt::format("cairn: {} input errors{}\n", all->errors().size(),
+                     all->truncated() ? " (reading stopped there: there may be more)" : "");
+}
 
 void print_warnings(const cairn::Config& config) {
   for (const auto& w : config.warnings) std::cerr << "cairn: warning: " << w << "\n";
@@ -201,7 +283,11 @@ int main(int argc, char** argv) {
 
   auto* restart = app.add_subcommand("restart", "continue a run from a checkpoint file");
   restart->add_option("checkpoint", input, "checkpoint-NNNN.h5 written by a run")->required();
-  restart->add_option("--set", overrides, "override an input key of the stored input");
+  std::string honoured;
+  for (const auto& k : cairn::restart_keys()) honoured += (honoured.empty() ? "" : ", ") + k;
+  restart->add_option("--set", overrides,
+                      "override a key of the stored input, one of those a restart honours: " + honoured +
+                          " (others made the stored state and are refused)");
   restart->add_flag("-q,--quiet", quiet, "no progress line and no summary");
   restart->add_option("-t,--threads", threads, threads_help)
       ->check(CLI::Range(0, max_threads));
@@ -258,6 +344,7 @@ int main(int argc, char** argv) {
       const cairn::Config config = cairn::load_config(input, overrides);
       if (!root) return 0;
       print_warnings(config);
+      for (const auto& w : cairn::implausible_material_values(config)) std::cerr << "cairn: warning: " << w << "\n";
       std::cout << config.resolved_toml;
       describe(config);
       return 0;
@@ -275,7 +362,7 @@ int main(int argc, char** argv) {
     if (!quiet && root) print_summary(summary);
     return 0;
   } catch (const cairn::InputError& e) {
-    err << "cairn: input error: " << e.what() << "\n";
+    print_input_errors(err, e);
     return 2;
   } catch (const cairn::UnknownName& e) {
     err << "cairn: input error: " << e.what() << "\n";

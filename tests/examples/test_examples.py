@@ -210,7 +210,8 @@ def tutorial(cairn, source, out):
         proc = subprocess.run([cairn, "check", path], capture_output=True, text=True, timeout=300)
         if proc.returncode != 0:
             raise CheckFailed(f"cairn check {path} exited with {proc.returncode}: {proc.stderr}")
-        return [line for line in proc.stdout.splitlines() if not line.startswith("directory = ")]
+        return [line for line in proc.stdout.splitlines()
+                if not line.startswith(("directory = ", "# wall time estimate: "))]  # (a timing)
 
     check(resolved(case) == resolved(os.path.join(source, "examples", "disk_wall.toml")),
           f"tutorial: its {len(blocks)} TOML blocks make examples/disk_wall.toml")

@@ -5,6 +5,7 @@ checkpoints, output folders relative to the input file, leftovers of killed runs
 Usage: /usr/bin/python3 test_cli.py <cairn binary> <source dir>
 """
 import csv
+import math
 import os
 import pty
 import re
@@ -258,6 +259,115 @@ def thread_binding(cairn, tmp):
               f"({bound})")
 
 
+def input_errors_at_once(cairn, tmp):
+    # Every independent error of a file in one run, each on its own line with file:line and key.
+    case = write_case(os.path.join(tmp, "errors", "case.toml"))
+    with open(case) as f:
+        text = f.read()
+    text = text.replace("cell_size = 5.0e-4", "cell_size = 5.0e-4\ncfl = 0.3")
+    text = text.replace("every = 5e-07", "every = 5e-07\nend_time = 1.0").replace("end_time = 2e-06\n", "")
+    with open(case, "w") as f:
+        f.write(text)
+    proc = cairn_run(cairn, ["check", case], expect=2)
+    lines = [l for l in proc.stderr.splitlines() if l.startswith("cairn: input error: ")]
+    check(len(lines) == 3 and "3 input errors" in proc.stderr,
+          f"three errors of one file reported in one run: {proc.stderr.strip()!r}")
+    check("key 'simulation.end_time'" in lines[0] and "required key" in lines[0],
+          "the missing simulation.end_time is reported")
+    check("case.toml:8: key 'grid.cfl'" in lines[1] and "did you mean simulation.cfl?" in lines[1],
+          "cfl under [grid] says where it belongs")
+    check("key 'output.end_time'" in lines[2] and "did you mean simulation.end_time?" in lines[2],
+          "end_time under [output] is reported too, with where it belongs")
+
+
+def restart_keys(cairn, tmp):
+    out = os.path.join(tmp, "restart_keys")
+    case = write_case(os.path.join(out, "case.toml"), directory="out")
+    cairn_run(cairn, ["run", case, "-q", "--set", "output.checkpoint_every=1.0e-6"])
+    folder = os.path.join(out, "out")
+    first = os.path.join(folder, "checkpoint-0000.h5")
+    for key, value in (("material[0].density", "2000"), ("material.0.youngs_modulus", "1e9"),
+                       ("grid.cell_size", "1e-3"), ("method.shape", "linear"), ("simulation.cfl", "0.2")):
+        proc = cairn_run(cairn, ["restart", first, "-q", "--set", f"{key}={value}"], expect=2)
+        check(f"key '{key}'" in proc.stderr and "a restart honours" in proc.stderr and "simulation.end_time" in proc.stderr
+              and "cairn run" in proc.stderr, f"restart refuses --set {key} (exit 2), naming the honoured keys")
+    help_text = cairn_run(cairn, ["restart", "--help"]).stdout
+    check("output.every" in help_text and "simulation.end_time" in help_text,
+          "cairn restart --help lists the keys a restart honours")
+
+    # A changed snapshot interval applies from the checkpoint on, on multiples of the new one.
+    with h5py.File(first, "r") as f:
+        t_ckpt = float(f.attrs["time"])
+    cairn_run(cairn, ["restart", first, "-q", "--set", "output.every=2.5e-7"])
+    later = [t for t in xdmf_times(os.path.join(folder, "particles.xdmf")) if t > t_ckpt * (1 + 1e-9)]
+    check(len(later) == 4 and later[0] >= 1.25e-6 * (1 - 1e-9),
+          f"--set output.every=2.5e-7 on restart: snapshots after t = {t_ckpt:.3g} at {later}")
+
+    # A finished run: restarting it says so and how to go on.
+    with h5py.File(os.path.join(folder, "checkpoint-0001.h5"), "r") as f:
+        t_last = float(f.attrs["time"])
+    check(abs(t_last - 2.0e-6) < 1e-12, f"checkpoint-0001.h5 is at the end (t = {t_last:.3g})")
+    last = os.path.join(folder, "checkpoint-0001.h5")
+    proc = cairn_run(cairn, ["restart", last, "-q"], expect=2)
+    check("simulation.end_time" in proc.stderr and "where this run finished" in proc.stderr
+          and "--set simulation.end_time=" in proc.stderr,
+          f"restarting a finished run says so and how to continue: {proc.stderr.strip()[:200]!r}")
+    cairn_run(cairn, ["restart", last, "-q", "--set", "simulation.end_time=3.0e-6"])
+    rows = history_rows(folder)
+    check(abs(float(rows[-1][0]) - 3.0e-6) < 1e-12, "raising simulation.end_time continues the finished run")
+
+
+def earlier_outputs(cairn, tmp):
+    out = os.path.join(tmp, "earlier")
+    case = write_case(os.path.join(out, "case.toml"), every=2.5e-7, directory="out")
+    folder = os.path.join(out, "out")
+    cairn_run(cairn, ["run", case, "-q"])
+    many = snapshot_files(folder)
+    check(len(many) == 9, f"a first run writes 9 snapshots ({len(many)})")
+    proc = cairn_run(cairn, ["run", case, "-q", "--set", "output.every=1.0e-6", "--set", "output.existing=keep"])
+    check(len(snapshot_files(folder)) == 9 and "removing" not in proc.stderr,
+          "output.existing = keep leaves the earlier run's snapshots")
+    cairn_run(cairn, ["run", case, "-q", "--set", "output.every=1.0e-6", "--set", "output.existing=error"], expect=2)
+    proc = cairn_run(cairn, ["run", case, "-q", "--set", "output.every=1.0e-6"])
+    files = snapshot_files(folder)
+    times = xdmf_times(os.path.join(folder, "particles.xdmf"))
+    check(len(files) == len(times) == 3, f"a second run with fewer outputs leaves only its own: {files}")
+    check("cairn: removing 9 snapshot files and 1 checkpoint of an earlier run in" in proc.stderr,
+          f"and says what it removed first: {proc.stderr.strip()!r}")
+
+
+def check_estimates(cairn, tmp):
+    case = write_case(os.path.join(tmp, "estimates", "case.toml"))
+    proc = cairn_run(cairn, ["check", case])
+    check("warning" not in proc.stderr, f"steel with SI values draws no warning: {proc.stderr.strip()!r}")
+    m = re.search(r"# material 'steel': wave speed ([0-9.e+-]+) m/s, step limit .* = ([0-9.e+-]+) s "
+                  r"\(fastest: sets the time step\)", proc.stdout)
+    check(m is not None, "cairn check prints the material's wave speed and step limit")
+    E, nu, rho = 200.0e9, 0.3, 7800.0
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    c = ((lam + 2 * mu) / rho) ** 0.5
+    check(abs(float(m.group(1)) / c - 1) < 1e-3, f"the wave speed {m.group(1)} is sqrt((lambda + 2 mu) / rho) = {c:.6g}")
+    dt = float(re.search(r"# first time step: ([0-9.e+-]+)", proc.stdout).group(1))
+    check(abs(dt / (0.5 * 5.0e-4 / (c + 10.0)) - 1) < 1e-3, f"the first step {dt:.4g} is cfl h / (c + |v|)")
+    steps = float(re.search(r"# estimated steps: ([0-9.e+]+)", proc.stdout).group(1))
+    check(steps == math.ceil(2.0e-6 / dt - 1e-9), f"estimated steps {steps:g} = end_time / first step")
+    check(re.search(r"# wall time estimate: [0-9.e+-]+ s \([0-9.e+-]+ s per step over [0-9]+ timed step", proc.stdout),
+          "and a wall-time estimate from timed steps")
+    proc = cairn_run(cairn, ["check", case, "--set", "material[0].density=1.0"])
+    warnings = [l for l in proc.stderr.splitlines() if l.startswith("cairn: warning: ")]
+    check(any("key 'material[0].density'" in w and "below that of any real solid" in w and "cgs" in w for w in warnings),
+          f"steel with density 1.0 is flagged as a likely slip (g/cm^3): {warnings}")
+    check(any("wave speed" in w and "faster than any real solid" in w for w in warnings),
+          "and its wave speed as faster than any solid's")
+
+
+def keys_explain_seeds(cairn, tmp):
+    text = " ".join(cairn_run(cairn, ["keys"]).stdout.split())
+    header = text.split("[simulation]")[0]
+    check("seed 001 = Wallstedt and Guilkey" in header and "seed 001 Eq. 34" in text,
+          "cairn keys says what the \"seed 001\" its keys cite is")
+
+
 def main():
     if len(sys.argv) < 3:
         print("usage: test_cli.py <cairn binary> <source dir>", file=sys.stderr)
@@ -266,7 +376,8 @@ def main():
     with tempfile.TemporaryDirectory(prefix="cairn_cli_") as tmp:
         try:
             for case in (usage_and_exit_codes, gmsh_loaded_on_demand, progress_bar, interrupts, wall_clock_checkpoints,
-                         relative_folders_and_restarts, orphan_temporaries, thread_binding):
+                         relative_folders_and_restarts, orphan_temporaries, thread_binding, input_errors_at_once,
+                         restart_keys, earlier_outputs, check_estimates, keys_explain_seeds):
                 print(case.__name__)
                 case(cairn, tmp)
         except (CheckFailed, subprocess.TimeoutExpired) as e:

@@ -348,6 +348,103 @@ TEST(InputErrors, UnreadableFile) {
   }
 }
 
+// ---- every independent error in one reading ---------------------------------------------
+
+/// The errors of the InputErrors that loading `text` raises (a test failure when fewer than two).
+std::vector<InputError> errors_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    load_config_string(text, "case.toml", overrides);
+  } catch (const InputErrors& e) {
+    EXPECT_EQ(std::string(e.what()).find(e.errors().front().what()), 0u) << "what() starts with the first";
+    return e.errors();
+  } catch (const InputError& e) {
+    ADD_FAILURE() << "expected several errors, got one: " << e.what();
+    return {e};
+  }
+  ADD_FAILURE() << "expected InputErrors";
+  return {};
+}
+
+TEST(InputErrors, EveryIndependentErrorOfAFileInOneReading) {
+  // A key in the wrong section, a bad choice, a value out of range and a stray key in a body:
+  // none stops the reading, so all four come back, in file order, each with line and key.
+  std::string text = with("cell_size = 1.0e-3", "cell_size = 1.0e-3\ncfl = 0.3");  // line 11
+  text = with("shape = \"bspline2\"", "shape = \"cpdii\"", text);                  // line 14
+  text = with("velocity = [8.165, 0.0]", "velocity = [8.165, 0.0]\nvelocty = 1", text);  // line 29
+  text += "\n[output]\nevery = -1.0\n";                                               // line 35
+  const auto errors = errors_of(text);
+  ASSERT_EQ(errors.size(), 4u);
+  EXPECT_EQ(errors[0].line(), 11);
+  EXPECT_EQ(errors[0].key(), "grid.cfl");
+  EXPECT_EQ(std::string(errors[0].what()),
+            "case.toml:11: key 'grid.cfl': expected a key declared for [grid] ('cfl' is a key of [simulation]: "
+            "did you mean simulation.cfl?); found an undeclared key");
+  EXPECT_EQ(errors[1].line(), 14);
+  EXPECT_EQ(errors[1].key(), "method.shape");
+  EXPECT_EQ(errors[1].found(), "\"cpdii\"");
+  EXPECT_EQ(errors[2].line(), 29);
+  EXPECT_EQ(errors[2].key(), "body[0].velocty");
+  EXPECT_NE(errors[2].expected().find("did you mean 'velocity'?"), std::string::npos) << errors[2].expected();
+  EXPECT_EQ(errors[3].line(), 35);
+  EXPECT_EQ(errors[3].key(), "output.every");
+}
+
+TEST(InputErrors, AStrayKeyAndTheMissingRequiredKeyBothReported) {
+  // end_time moved from [simulation] to [output]: the missing key stops the reading, the stray
+  // one is still found, and says where it belongs.
+  std::string text = with("end_time = 2.0e-3\n", "");
+  text += "\n[output]\nend_time = 2.0e-3\n";
+  const auto errors = errors_of(text);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].key(), "simulation.end_time");
+  EXPECT_NE(errors[0].expected().find("required key"), std::string::npos) << errors[0].what();
+  EXPECT_EQ(errors[1].key(), "output.end_time");
+  EXPECT_NE(std::string(errors[1].what()).find("did you mean simulation.end_time?"), std::string::npos)
+      << errors[1].what();
+}
+
+TEST(InputErrors, AMaterialKeyInAnotherSectionSaysWhereItBelongs) {
+  const auto e = error_of(with("cfl = 0.4", "youngs_modulus = 1.0e6"));
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->key(), "simulation.youngs_modulus");
+  EXPECT_NE(e->expected().find("'youngs_modulus' is a key of [[material]] (model "), std::string::npos)
+      << e->expected();
+}
+
+TEST(InputErrors, BadOverridesAndFileErrorsTogether) {
+  const auto errors = errors_of(with("cfl = 0.4", "cfl = 3.0"), {"method.nope=1", "output.every=-2"});
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0].file(), "--set method.nope=1");  // overrides (line 0) first
+  EXPECT_EQ(errors[1].file(), "--set output.every=-2");
+  EXPECT_EQ(errors[2].line(), 5);
+  EXPECT_EQ(errors[2].key(), "simulation.cfl");
+}
+
+TEST(InputErrors, ReadingStopsAtTheCap) {
+  std::string text = base + "\n[output]\n";
+  for (int i = 0; i < 30; ++i) text += "stray_" + std::to_string(i) + " = 1\n";
+  try {
+    load_config_string(text, "case.toml");
+    FAIL() << "expected InputErrors";
+  } catch (const InputErrors& e) {
+    EXPECT_EQ(e.errors().size(), InputErrors::max_reported);
+    EXPECT_TRUE(e.truncated());
+    EXPECT_EQ(e.errors().front().key(), "output.stray_0");
+  }
+}
+
+TEST(InputErrors, AnErrorThatLeavesTheRestUnreadableStopsTheReading) {
+  // A bad dimension would make every array's length wrong: nothing after it is reported.
+  try {
+    load_config_string(with("dimension = 2", "dimension = 5") + "\n[output]\nevery = -1.0\n", "case.toml");
+    FAIL() << "expected an InputError";
+  } catch (const InputErrors& e) {
+    FAIL() << "expected one error, got " << e.what();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "simulation.dimension");
+  }
+}
+
 // ---- positive paths -----------------------------------------------------------------------
 
 void expect_same(const Config& a, const Config& b) {

@@ -41,7 +41,7 @@ class Runner {
   void restore(const Checkpoint& c) {
     solver_.restore(c.state);
     initial_energy_ = c.scalars.at("initial_energy");
-    schedule_.restore(c.scalars);
+    schedule_.restore(c.scalars, c.scalars.at("time"));
     checkpoint_index_ = static_cast<int>(c.scalars.at("checkpoint_index"));
     last_dt_ = c.scalars.at("previous_dt");
     history_writer_.set_rows(c.history_rows);

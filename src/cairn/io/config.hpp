@@ -275,6 +275,8 @@ struct OutputConfig {
   std::vector<std::string> exact_displacement;
   double checkpoint_wall_interval = 1800.0;  ///< wall-clock seconds between checkpoints; 0 = off
   int compression = 0;          ///< gzip level 0-9 of large HDF5 datasets; 0 = off
+  /// An earlier run's numbered files in the folder of a new run: "remove", "keep" or "error".
+  std::string existing = "remove";
 };
 
 struct Config {

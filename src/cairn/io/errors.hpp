@@ -8,9 +8,11 @@
 // The CLI catches it, prints what() and exits with status 2.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace cairn {
 
@@ -60,6 +62,32 @@ class InputError : public std::runtime_error {
   std::string key_;
   std::string expected_;
   std::string found_;
+};
+
+/// Several independent mistakes of one input, found in one reading (io/input.cpp: a key that is
+/// declared nowhere in its table, or one whose bad value can give way to its default, does not
+/// stop the reading; the first error that leaves the rest unreadable does). The InputError base
+/// is the first of them, so a handler of InputError sees what it always saw; errors() has them
+/// all in the order of the file and what() lists them one per line.
+class InputErrors : public InputError {
+ public:
+  /// At most this many are collected; `truncated` says the reading stopped there.
+  static constexpr std::size_t max_reported = 20;
+
+  InputErrors(std::vector<InputError> errors, bool truncated)
+      : InputError(errors.front()), errors_(std::move(errors)), truncated_(truncated) {
+    for (const auto& e : errors_) text_ += (text_.empty() ? "" : "\n") + std::string(e.what());
+  }
+
+  [[nodiscard]] const std::vector<InputError>& errors() const { return errors_; }
+  /// True when reading stopped at max_reported errors (there may be more).
+  [[nodiscard]] bool truncated() const { return truncated_; }
+  [[nodiscard]] const char* what() const noexcept override { return text_.c_str(); }
+
+ private:
+  std::vector<InputError> errors_;
+  bool truncated_;
+  std::string text_;
 };
 
 }  // namespace cairn

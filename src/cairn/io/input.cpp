@@ -261,6 +261,43 @@ std::vector<KeyDecl> copy_section(std::string_view section) {
   return out;
 }
 
+/// Where else a key named `key` is declared, as a hint for one found in the table at `path`:
+/// " ('cfl' is a key of [simulation]: did you mean simulation.cfl?)", or "" when nowhere else.
+std::string declared_elsewhere(const Path& path, const std::string& key) {
+  std::vector<std::string> places;
+  for (const auto& d : declared_keys())
+    if (d.name == key && d.section != path[0] && d.section.find('.') == std::string::npos &&
+        std::find(places.begin(), places.end(), d.section) == places.end())
+      places.push_back(d.section);
+  std::vector<std::string> models;  // a material model's own key
+  for (const auto& [model, info] : material_model_info())
+    for (const auto& d : info.keys)
+      if (d.name == key && std::find(models.begin(), models.end(), model) == models.end()) models.push_back(model);
+  if (!models.empty() && path[0] != "material") places.push_back("material");
+  if (places.empty()) return "";
+  std::vector<std::string> shown;
+  for (const auto& section : places)
+    shown.push_back(is_table_array(section) ? "[[" + section + "]]" : "[" + section + "]");
+  std::string text = fmt::format(" ('{}' is a key of {}", key, join(shown, " and "));
+  if (!models.empty() && path[0] != "material") text += fmt::format(" (model {})", join(models, ", "));
+  if (places.size() == 1 && !is_table_array(places[0])) text += fmt::format(": did you mean {}.{}?", places[0], key);
+  return text + ")";
+}
+
+/// The `expected` text for a key `key` that `decls` (the keys of the table at `path`, named
+/// `what` in messages) do not declare: where it belongs if another section declares it, else the
+/// closest declared name, else the list of keys.
+std::string undeclared_key_expected(const Path& path, const std::string& key, const std::vector<KeyDecl>& decls,
+                                    const std::string& what) {
+  std::vector<std::string> names;
+  for (const auto& d : decls) names.push_back(d.name);
+  if (const std::string elsewhere = declared_elsewhere(path, key); !elsewhere.empty())
+    return fmt::format("a key declared for {}{}", what, elsewhere);
+  const auto suggestion = closest(key, names);
+  return suggestion ? fmt::format("a key declared for {} (did you mean '{}'?)", what, *suggestion)
+                    : fmt::format("one of the keys of {}: {}", what, join(names));
+}
+
 // ---- the validator -----------------------------------------------------------------------
 
 class Loader;
@@ -355,8 +392,14 @@ class Loader {
 
   [[noreturn]] void fail(const Path& path, const toml::node* node, const std::string& expected,
                          const std::string& found) const {
+    failed_path_ = path;
+    throw error(path, node, expected, found);
+  }
+
+  [[nodiscard]] InputError error(const Path& path, const toml::node* node, const std::string& expected,
+                                 const std::string& found) const {
     const SourceLocation where = locate(path, node);
-    throw InputError(where.file, where.line, display(path), expected, found);
+    return InputError(where.file, where.line, display(path), expected, found);
   }
 
   /// Record a warning about the value at `path` ("file:line: key 'k': what"); load() hands them
@@ -381,7 +424,20 @@ class Loader {
 
  private:
   void apply_override(toml::table& root, const std::string& text);
+  /// One reading of the whole (overridden) tree; throws at its first error.
+  Config read_all(const toml::table& root);
+  /// Every key that its table does not declare, recorded in `errors` and removed from the tree,
+  /// so that the reading goes on past them; also every top-level entry that is not a section, or
+  /// not of its form: then it returns false (what it holds is missing where it belongs, so the
+  /// rest is not read).
+  bool remove_undeclared(toml::table& root, std::vector<InputError>& errors) const;
+  /// After an error at `failed_path_`: the key to take out of the tree so that reading can go on
+  /// past it with the key's default (an undeclared key, or a declared one with a default), or
+  /// nothing when the error leaves the rest unreadable (a required key, a cross-key error).
+  std::optional<Path> removable_key(const toml::table& root) const;
   void check_top_level(const toml::table& root) const;
+  /// One top-level entry: a known section, in the form it must have.
+  void check_top_level_entry(const std::string& key, const toml::node& entry) const;
   void read_simulation(const toml::table& root, Config& cfg);
   void read_grid(const toml::table& root, Config& cfg);
   void read_method(const toml::table& root, Config& cfg);
@@ -440,6 +496,7 @@ class Loader {
   std::vector<std::string> warnings_;
   int dim_ = 0;
   std::string length_unit_ = "m";  ///< the model's length unit (simulation.units), for mesh files' units
+  mutable std::optional<Path> failed_path_;  ///< where the last fail() was
 };
 
 // ---- TableReader ---------------------------------------------------------------------------
@@ -457,16 +514,9 @@ void TableReader::fail(const std::string& name, const toml::node* node, const st
 
 void TableReader::reject_unknown_keys() const {
   if (!table_) return;
-  std::vector<std::string> names;
-  for (const auto& d : decls_) names.push_back(d.name);
-  for (const auto& [key, node] : entries_in_file_order(*table_)) {
-    if (std::find(names.begin(), names.end(), key) != names.end()) continue;
-    const auto suggestion = closest(key, names);
-    const std::string expected =
-        suggestion ? fmt::format("a key declared for {} (did you mean '{}'?)", what_, *suggestion)
-                   : fmt::format("one of the keys of {}: {}", what_, join(names));
-    loader_.fail(path_of(key), node, expected, "an undeclared key");
-  }
+  for (const auto& [key, node] : entries_in_file_order(*table_))
+    if (std::none_of(decls_.begin(), decls_.end(), [&](const KeyDecl& d) { return d.name == key; }))
+      loader_.fail(path_of(key), node, undeclared_key_expected(path_, key, decls_, what_), "an undeclared key");
 }
 
 TableReader::Value TableReader::value(const std::string& name) {
@@ -870,28 +920,31 @@ void Loader::apply_override(toml::table& root, const std::string& text) {
 // ---- sections ------------------------------------------------------------------------------
 
 void Loader::check_top_level(const toml::table& root) const {
+  for (const auto& [key, node] : entries_in_file_order(root)) check_top_level_entry(key, *node);
+}
+
+void Loader::check_top_level_entry(const std::string& key, const toml::node& entry) const {
   const auto& sections = section_names();
-  for (const auto& [key, node] : entries_in_file_order(root)) {
-    if (std::find(sections.begin(), sections.end(), key) == sections.end()) {
-      std::string expected;
-      // A key written above its section header, e.g. `dimension = 2` before [simulation].
-      for (const auto& d : declared_keys())
-        if (d.name == key && d.section.find('.') == std::string::npos && expected.empty())
-          expected = fmt::format("a section, one of {} ('{}' belongs in [{}])", join(sections), key,
-                                 d.section);
-      if (expected.empty())
-        expected = "a section, one of " + join(sections) + did_you_mean(key, sections);
-      fail({key}, node, expected, node->is_table() ? "an unknown table" : "an undeclared key");
-    }
-    if (is_table_array(key)) {
-      const auto* a = node->as_array();
-      const bool tables = a && std::all_of(a->begin(), a->end(), [](const toml::node& n) { return n.is_table(); });
-      if (!tables)
-        fail({key}, node, fmt::format("an array of tables, written [[{}]]", key),
-             node->is_table() ? fmt::format("a single table [{}]", key) : typed_text(*node));
-    } else if (!node->is_table()) {
-      fail({key}, node, fmt::format("a table, written [{}]", key), typed_text(*node));
-    }
+  const toml::node* node = &entry;
+  if (std::find(sections.begin(), sections.end(), key) == sections.end()) {
+    std::string expected;
+    // A key written above its section header, e.g. `dimension = 2` before [simulation].
+    for (const auto& d : declared_keys())
+      if (d.name == key && d.section.find('.') == std::string::npos && expected.empty())
+        expected = fmt::format("a section, one of {} ('{}' belongs in [{}])", join(sections), key,
+                               d.section);
+    if (expected.empty())
+      expected = "a section, one of " + join(sections) + did_you_mean(key, sections);
+    fail({key}, node, expected, node->is_table() ? "an unknown table" : "an undeclared key");
+  }
+  if (is_table_array(key)) {
+    const auto* a = node->as_array();
+    const bool tables = a && std::all_of(a->begin(), a->end(), [](const toml::node& n) { return n.is_table(); });
+    if (!tables)
+      fail({key}, node, fmt::format("an array of tables, written [[{}]]", key),
+           node->is_table() ? fmt::format("a single table [{}]", key) : typed_text(*node));
+  } else if (!node->is_table()) {
+    fail({key}, node, fmt::format("a table, written [{}]", key), typed_text(*node));
   }
 }
 
@@ -1648,6 +1701,7 @@ void Loader::read_output(const toml::table& root, Config& cfg) {
   o.exact_displacement = r.expressions("exact_displacement", static_cast<std::size_t>(dim_), ExpressionVars::field);
   o.checkpoint_wall_interval = r.real("checkpoint_wall_interval");
   o.compression = r.small_integer("compression");
+  o.existing = r.string("existing");
 }
 
 void Loader::read_contact(const toml::table& root, Config& cfg) {
@@ -1724,7 +1778,115 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
 }
 
 Config Loader::load(toml::table& root, const std::vector<std::string>& overrides) {
-  for (const auto& o : overrides) apply_override(root, o);
+  // Every independent error in one reading: a bad --set is skipped, an undeclared key taken out,
+  // a bad value of a key with a default replaced by the default, until an error that leaves the
+  // rest unreadable or max_reported errors.
+  std::vector<InputError> errors;
+  for (const auto& o : overrides) {
+    try {
+      apply_override(root, o);
+    } catch (const InputError& e) {
+      errors.push_back(e);
+    }
+  }
+  if (remove_undeclared(root, errors)) {
+    while (errors.size() < InputErrors::max_reported) {
+      failed_path_.reset();
+      try {
+        Config cfg = read_all(root);
+        if (errors.empty()) return cfg;
+        break;
+      } catch (const InputError& e) {
+        errors.push_back(e);
+        const auto key = removable_key(root);
+        if (!key) break;
+        toml::node* holder = root.get((*key)[0]);
+        if (key->size() == 3) holder = holder->as_array()->get(std::stoul((*key)[1]));
+        holder->as_table()->erase(key->back());
+      }
+    }
+  }
+  if (errors.size() == 1) throw errors.front();
+  // In file order: the --set errors first, those without a line (a missing section) last.
+  const auto order = [](const InputError& e) {
+    return e.file().rfind("--set ", 0) == 0 ? -1 : e.line() > 0 ? e.line() : INT_MAX;
+  };
+  std::stable_sort(errors.begin(), errors.end(),
+                   [&](const InputError& a, const InputError& b) { return order(a) < order(b); });
+  const bool truncated = errors.size() >= InputErrors::max_reported;
+  if (truncated) errors.erase(errors.begin() + static_cast<std::ptrdiff_t>(InputErrors::max_reported), errors.end());
+  throw InputErrors(std::move(errors), truncated);
+}
+
+bool Loader::remove_undeclared(toml::table& root, std::vector<InputError>& errors) const {
+  bool readable = true;
+  // Takes every key that `decls` do not declare out of `table` (at `path`, named `what`).
+  auto scan = [&](toml::table& table, const Path& path, const std::vector<KeyDecl>& decls, const std::string& what) {
+    for (const auto& [key, node] : entries_in_file_order(table))
+      if (std::none_of(decls.begin(), decls.end(), [&](const KeyDecl& d) { return d.name == key; })) {
+        errors.push_back(error(child(path, key), node, undeclared_key_expected(path, key, decls, what),
+                               "an undeclared key"));
+        table.erase(key);
+      }
+  };
+  for (const auto& [key, node] : entries_in_file_order(root)) {
+    try {
+      check_top_level_entry(key, *node);
+    } catch (const InputError& e) {
+      // A misspelt section or a key above its section's header: the keys it holds are missing
+      // from where they belong, and reading on would only report that again.
+      errors.push_back(e);
+      readable = false;
+      continue;
+    }
+    if (key == "constants") continue;  // a free table
+    if (!is_table_array(key)) {
+      scan(*root.get_as<toml::table>(key), {key}, copy_section(key), "[" + key + "]");
+      continue;
+    }
+    auto& entries = *root.get_as<toml::array>(key);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      auto& entry = *entries.get(i)->as_table();
+      if (key != "material") {
+        scan(entry, child(Path{key}, i), copy_section(key), "[[" + key + "]]");
+        continue;
+      }
+      // A material's keys are those of its model; with no valid model the reading says so.
+      const auto* model = entry.get_as<std::string>("model");
+      if (!model || material_model_info().count(model->get()) == 0) continue;
+      scan(entry, child(Path{key}, i), material_keys(model->get()),
+           fmt::format("[[material]] with model '{}'", model->get()));
+    }
+  }
+  return readable;
+}
+
+std::optional<Path> Loader::removable_key(const toml::table& root) const {
+  if (!failed_path_ || failed_path_->empty() || (*failed_path_)[0] == "constants") return std::nullopt;
+  const Path& p = *failed_path_;
+  const std::size_t depth = is_table_array(p[0]) ? 3 : 2;
+  if (p.size() < depth) return std::nullopt;
+  const toml::node* holder = root.get(p[0]);
+  if (holder && depth == 3)
+    holder = holder->is_array() ? holder->as_array()->get(std::stoul(p[1])) : nullptr;
+  const toml::table* table = holder ? holder->as_table() : nullptr;
+  const std::string& name = p[depth - 1];
+  if (!table || !table->contains(name)) return std::nullopt;
+  const auto* model = table->get_as<std::string>("model");
+  const std::vector<KeyDecl> decls =
+      p[0] == "material" ? material_keys(model ? model->get() : "") : copy_section(p[0]);
+  const auto d = std::find_if(decls.begin(), decls.end(), [&](const KeyDecl& k) { return k.name == name; });
+  // Undeclared keys go; so does a declared key whose default stands in for it. Without a default
+  // (a required key, a material constant) the error would only come back as another.
+  if (d != decls.end() && (d->required || d->default_value.empty())) return std::nullopt;
+  return Path(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(depth));
+}
+
+Config Loader::read_all(const toml::table& root) {
+  warnings_.clear();
+  condition_names_.clear();
+  constants_ = {};
+  dim_ = 0;
   check_top_level(root);
   Config cfg;
   cfg.source_file = file_;
@@ -2029,6 +2191,7 @@ std::string config_to_toml(const Config& c) {
     line("exact_displacement", array_text(out.exact_displacement, expression_text));
   line("checkpoint_wall_interval", real_text(out.checkpoint_wall_interval));
   line("compression", fmt::format("{}", out.compression));
+  line("existing", toml_string(out.existing));
   return o;
 }
 

@@ -3,6 +3,7 @@
 // [output] (docs/output.md). Shared by the MPM run loop (sim/run.cpp) and the reference FEM's
 // (fem/run.cpp), so that both write at the same times and restart the same way.
 
+#include <algorithm>
 #include <map>
 #include <string>
 
@@ -59,19 +60,34 @@ class OutputSchedule {
     if (!wrote_snapshot_) write_snapshot();
   }
 
-  /// The counters a checkpoint stores (and restore() reads back).
+  /// The counters and intervals a checkpoint stores (and restore() reads back).
   void save(std::map<std::string, double>& scalars) const {
     scalars["snapshots_done"] = static_cast<double>(snapshot_.done);
     scalars["history_done"] = static_cast<double>(history_.done);
     scalars["checkpoints_done"] = static_cast<double>(checkpoint_.done);
+    scalars["snapshot_interval"] = snapshot_.interval;
+    scalars["history_interval"] = history_.interval;
+    scalars["checkpoint_interval"] = checkpoint_.interval;
   }
-  void restore(const std::map<std::string, double>& scalars) {
-    snapshot_.done = static_cast<long long>(scalars.at("snapshots_done"));
-    history_.done = static_cast<long long>(scalars.at("history_done"));
-    checkpoint_.done = static_cast<long long>(scalars.at("checkpoints_done"));
+  /// From a checkpoint at time t. A clock whose interval `cairn restart --set` changed counts
+  /// its outputs again as if it had always had the new one, so the next falls on a multiple of
+  /// it (checkpoints written before the intervals were stored keep their counters).
+  void restore(const std::map<std::string, double>& scalars, double t) {
+    restore_one(snapshot_, scalars, "snapshots_done", "snapshot_interval", t);
+    restore_one(history_, scalars, "history_done", "history_interval", t);
+    restore_one(checkpoint_, scalars, "checkpoints_done", "checkpoint_interval", t);
   }
 
  private:
+  static void restore_one(Schedule& clock, const std::map<std::string, double>& scalars, const char* done,
+                          const char* interval, double t) {
+    clock.done = static_cast<long long>(scalars.at(done));
+    const auto stored = scalars.find(interval);
+    if (stored == scalars.end() || stored->second == clock.interval) return;
+    clock.done = clock.interval > 0.0 ? std::max(0LL, static_cast<long long>(t / clock.interval) - 2) : 0;
+    clock.advance(t);
+  }
+
   Schedule history_, snapshot_, checkpoint_;
   bool wrote_history_ = true, wrote_snapshot_ = true;  ///< at start-up the initial outputs are written
 };

@@ -716,6 +716,13 @@ std::vector<KeyDecl> make_declarations() {
                 .by_default("0")
                 .min(0)
                 .max(9));
+  k.push_back(Key("output", "existing", T::string,
+                 "What a new run (not a restart) does with the numbered files an earlier run left in "
+                 "its folder (snapshots/particles-*.h5, checkpoint-*.h5, checkpoint-autosave.h5, "
+                 "failure files): remove = delete them first, saying how many (the new run writes its "
+                 "own); keep = leave them beside the new ones; error = refuse to run (exit 2).")
+                .by_default("\"remove\"")
+                .choices([] { return std::vector<std::string>{"remove", "keep", "error"}; }));
   return k;
 }
 
@@ -995,6 +1002,16 @@ std::vector<KeyDecl> copy_section(std::string_view section) {
   return out;
 }
 
+/// The source papers that docs cite as "seed 00N" (README.md, "seed" table), for the headers of
+/// `cairn keys` and docs/input.md.
+constexpr const char* seeds_cited =
+    "Docs cite the five source papers as \"seed 00N\" (README.md lists them): seed 000 = Nairn and "
+    "Hammerquist, full mass matrix MPM (FMPM, XPIC, boundary conditions); seed 001 = Wallstedt and "
+    "Guilkey, weighted least squares PIC (WLS); seed 002 = Nairn, notes on MPM extrapolations "
+    "(particle updates); seed 003 = Steffen, Wallstedt, Guilkey, Kirby and Berzins, MPM "
+    "implementation choices (shape functions, time integration); seed 004 = Nairn, Hammerquist and "
+    "Smith, MPM contact algorithms.";
+
 std::string markdown_text() {
   std::string out;
   out +=
@@ -1007,7 +1024,12 @@ std::string markdown_text() {
       "default, allowed range or choices and a one-line doc; this page is generated from those "
       "declarations. Unknown keys, misspelled sections, values of the wrong type or out of "
       "range are errors that name the file, the line and the key, what was expected and what "
-      "was found.\n"
+      "was found; every independent error of a file is reported in one run (up to 20), and a "
+      "key written in the wrong section says which section declares it.\n"
+      "\n";
+  out += seeds_cited;
+  out +=
+      "\n"
       "\n"
       "- `D` is `simulation.dimension`; `real[D]` is an array with one number per axis.\n"
       "- Integers are accepted wherever a real is expected.\n"
@@ -1213,6 +1235,8 @@ std::string plain_text() {
       "reference.\n"
       "Override any key with --set section.key=value; [[material]] and [[body]] entries by\n"
       "index: --set material.0.density=1100\n";
+  for (const auto& line : wrap(seeds_cited, plain_width))
+    out += line + "\n";
   for (const auto& s : section_docs()) {
     out += fmt::format("\n{}\n", s.heading);
     if (s.name == "constants") {

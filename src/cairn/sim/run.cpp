@@ -83,6 +83,25 @@ void remove_orphan_temporaries(const std::filesystem::path& folder) {
   for (const auto& p : orphans) std::filesystem::remove(p, ec);
 }
 
+/// The files of Cairn's numbered outputs in a run folder (docs/output.md): snapshot files,
+/// checkpoints, failure snapshots and the XDMF indexes of those series. An earlier run's are
+/// removed before a new run writes there (output.existing), so that a script that globs the
+/// folder sees one run; history.csv is rewritten anyway.
+std::vector<std::filesystem::path> earlier_outputs(const std::filesystem::path& folder) {
+  static const std::regex top(R"((checkpoint-([0-9]{4,}|autosave)\.h5|(particles|grid|wls_cells|failure)\.xdmf))");
+  static const std::regex numbered(R"((particles|wls_cells|failure)-[0-9]{6}\.h5)");
+  std::vector<std::filesystem::path> found;
+  std::error_code ec;
+  for (const auto& [where, pattern] : {std::pair{folder, &top}, std::pair{folder / "snapshots", &numbered}}) {
+    if (!std::filesystem::is_directory(where, ec)) continue;
+    for (const auto& entry : std::filesystem::directory_iterator(where, ec))
+      if (entry.is_regular_file(ec) && std::regex_match(entry.path().filename().string(), *pattern))
+        found.push_back(entry.path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 /// "1 h 02 min", "3 min 20 s", "42 s".
 std::string duration_text(double seconds) {
   const long long s = std::llround(std::max(0.0, seconds));
@@ -192,7 +211,7 @@ class Runner {
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
     initial_energy_ = data.scalars.at("initial_energy");
     if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
-    schedule_.restore(data.scalars);
+    schedule_.restore(data.scalars, data.time);
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
     history_writer_.set_rows(rows_for_columns(data));
@@ -235,6 +254,7 @@ class Runner {
     const auto& s = config_.simulation;
     n_particles_ = sim_.total_particles();
     if (!restarted_) {
+      clear_earlier_outputs();
       if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
         std::fprintf(stderr, "cairn: %s\n", note.c_str());
       initial_energy_ = energy();
@@ -309,6 +329,36 @@ class Runner {
   }
 
  private:
+  /// A new run into a folder where an earlier run left numbered outputs: remove them (saying
+  /// how many), keep them or refuse, as output.existing says. Every rank lists the folder (the
+  /// same answer on a shared file system), rank 0 alone removes.
+  void clear_earlier_outputs() {
+    const auto earlier = earlier_outputs(dir_);
+    comm_.barrier();
+    const std::string& mode = config_.output.existing;
+    if (earlier.empty() || mode == "keep") return;
+    long long snapshots = 0, checkpoints = 0;
+    for (const auto& p : earlier) {
+      const std::string name = p.filename().string();
+      if (name.rfind("checkpoint-", 0) == 0) ++checkpoints;
+      else if (p.extension() == ".h5") ++snapshots;
+    }
+    const std::string what = fmt::format("{} snapshot file{} and {} checkpoint{} of an earlier run in {}", snapshots,
+                                         snapshots == 1 ? "" : "s", checkpoints, checkpoints == 1 ? "" : "s",
+                                         dir_.string());
+    if (mode == "error")
+      throw InputError(config_.source_file, 0, "output.existing",
+                       "an output folder without an earlier run's files (output.existing = \"error\")",
+                       what + "; remove them, choose another output.directory, or set output.existing = "
+                              "\"remove\" or \"keep\"");
+    if (comm_.is_root()) {
+      std::fprintf(stderr, "cairn: removing %s (output.existing = \"keep\" would keep them)\n", what.c_str());
+      std::error_code ec;
+      for (const auto& p : earlier) std::filesystem::remove(p, ec);
+    }
+    comm_.barrier();
+  }
+
   double energy() const {
     const Totals t = sim_.totals();
     return t.kinetic_energy + t.strain_energy;
@@ -609,6 +659,13 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+  const double end = config.simulation.end_time;
+  if (data.time >= end * (1.0 - 1e-12))
+    throw InputError(file.string(), 0, "simulation.end_time",
+                     fmt::format("an end time after the checkpoint's t = {:.6g} to continue to", data.time),
+                     fmt::format("{0:.6g}, where this run finished; to go on, raise it: cairn restart {1} --set "
+                                 "simulation.end_time=<a time after {0:.6g}>",
+                                 end, file.string()));
   refuse_wls_on_ranks(config, file.string());
   // The stored input's load-time warnings (and those of new --set values), as `cairn run` prints
   // them (rank 0 alone on several ranks).
@@ -618,8 +675,36 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
 }
 }  // namespace
 
+const std::vector<std::string>& restart_keys() {
+  static const std::vector<std::string> keys{
+      "simulation.end_time",        "simulation.max_steps",       "simulation.threads",
+      "simulation.adapt_threads",   "simulation.sort_particles",  "simulation.rebalance_threshold",
+      "simulation.memory_limit",    "simulation.max_estimated_steps",
+      "output.directory",           "output.every",               "output.history_every",
+      "output.checkpoint_every",    "output.checkpoint_wall_interval", "output.checkpoints",
+      "output.snapshots",           "output.grid_snapshots",      "output.compression"};
+  return keys;
+}
+
 RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
                    const RunOptions& options) {
+  // The checkpoint holds the particles (masses, positions, material state), the grid and the
+  // counters the first input made; keys that made them would only half apply (the stored input
+  // would say one thing, the state another), so only the keys that steer the continuation do.
+  for (const auto& o : overrides) {
+    std::string key = o.substr(0, o.find('='));
+    key.erase(0, key.find_first_not_of(" \t"));
+    key.erase(key.find_last_not_of(" \t") + 1);
+    const auto& honoured = restart_keys();
+    if (std::find(honoured.begin(), honoured.end(), key) != honoured.end() || o.find('=') == std::string::npos)
+      continue;  // (a malformed --set is reported by the reading, as for cairn run)
+    std::string list;
+    for (const auto& k : honoured) list += (list.empty() ? "" : ", ") + k;
+    throw InputError("--set " + o, 0, key, "one of the keys a restart honours: " + list,
+                     "a key that made the stored state: the checkpoint's particles (masses, positions, "
+                     "material state) and grid came from the original input and would not follow a "
+                     "new value; change it in the input file and start again with cairn run");
+  }
   // The restarted run writes next to the checkpoint it was given (not into the folder stored in
   // it, which may belong to another run or machine), unless --set output.directory says where.
   std::vector<std::string> all = overrides;

@@ -67,7 +67,15 @@ RunSummary run(const Config& config, const RunOptions& options);
 /// when the CFL rule with simulation.cfl * sqrt(k) <= 0.6 is used, or for other updates.
 std::string time_step_note(const Config& config);
 
-/// Continue from a checkpoint written by run(); `overrides` (`--set`) apply to the stored input.
+/// The keys `cairn restart --set` honours: when the run stops and how long, threads and memory
+/// guards, what is written and where. Any other key (a material, the grid, the method, a body,
+/// a boundary condition) made the state the checkpoint holds, so a new value would not reach
+/// it: restart() refuses it.
+const std::vector<std::string>& restart_keys();
+
+/// Continue from a checkpoint written by run(); `overrides` (`--set`, only restart_keys()) apply
+/// to the stored input; any other key throws InputError (exit 2), and so does a checkpoint that
+/// already reached simulation.end_time (the message says how to go on).
 /// The output goes to the checkpoint's folder unless an override sets output.directory; there
 /// history.csv and the XDMF files are first cut back to the checkpoint's time (later snapshot
 /// files of the series are deleted). A restart without overrides ends bit-identical to the run
