@@ -566,9 +566,17 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
     if (counted) ++active_;
     if (count_energy && grid_->owns(node))
       for (int y = 0; y < k; ++y) {
-        // 1/2 m |v + dp/m|^2 - 1/2 m |v|^2 = dp.v + |dp|^2 / (2m)
         const Vec3& d = energy_of_free_part ? dp_free[y] : dp_total[y];
-        if (m[y] > 0.0) energy_change_.add(d.dot(p[y]) / m[y] + 0.5 * d.squaredNorm() / m[y]);
+        if (!(m[y] > 0.0)) continue;
+        if (pass == Pass::updated && start_velocity_) {
+          // The work of the contact impulse at the step's mean grid velocity, as the external
+          // work is measured: dp . (v + v+_corrected) / 2 with v+_corrected = v+ + dp / m.
+          const Vec3 v0 = to3<D>((*start_velocity_)[slot(b0 + y)]);
+          energy_change_.add(0.5 * d.dot(v0 + p[y] / m[y]) + 0.5 * d.squaredNorm() / m[y]);
+        } else {
+          // 1/2 m |v + dp/m|^2 - 1/2 m |v|^2 = dp.v + |dp|^2 / (2m) (an impulse on the particles)
+          energy_change_.add(d.dot(p[y]) / m[y] + 0.5 * d.squaredNorm() / m[y]);
+        }
       }
     for (int x = b0; x < b1; ++x) {
       const std::size_t s = slot(x);

@@ -66,6 +66,9 @@ class Contact {
   [[nodiscard]] double dissipated() const { return dissipated_; }
   void set_dissipated(double value) { dissipated_ = value; }
   void count_first_correction(bool yes) { energy_from_first_ = yes; }
+  /// The nodal velocities at the start of the step (slots), whose mean with the corrected
+  /// updated velocities weighs the second correction's impulse (as the external work is weighed).
+  void set_start_velocity(const std::vector<Vec<D>>* v) { start_velocity_ = v; }
   /// What the last updated pass did at one contact node for one field pair (trace(true)).
   struct NodeTrace {
     enum State : std::int8_t { bonded, no_normal, separating, gap_open, stick, slip };
@@ -161,6 +164,7 @@ class Contact {
   ExactSum energy_change_;        ///< this rank's energy change since the last reduce()
   double dissipated_ = 0.0;
   bool energy_from_first_ = false;
+  const std::vector<Vec<D>>* start_velocity_ = nullptr;
   bool tracing_ = false;
   std::vector<NodeTrace> trace_;
   double prepare_seconds_ = 0.0, fit_seconds_ = 0.0, correct_seconds_ = 0.0;

@@ -126,6 +126,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // (first_correction = "impulse"); otherwise only the second correction's does (the particle
     // update takes v+ - v, or v+ whose change the dissipation tally of the update already sees).
     contact_->count_first_correction(contact_->impulse() && contact_->corrects_extrapolation());
+    contact_->set_start_velocity(&nodes_.velocity);
   }
   // Scratch node arrays only where the step uses them: full-mass expansions (FMPM, XPIC and
   // their blends) and the second stress-update velocity of USF/USAVG/USL+/USAVG+.
