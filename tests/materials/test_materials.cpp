@@ -175,6 +175,24 @@ TEST(Materials, CorotationalLinearElasticIsHookesLawForSmallStrains) {
   }
 }
 
+TEST(Materials, CorotationalLinearElasticSeriesAndEigenPathsAgree) {
+  // 3D: small strains take the binomial series of sqrt(I + D), large ones the eigen-decomposition;
+  // both against V = sqrt(F F^T) from Eigen's iterative symmetric solver, across the switch.
+  const double lambda = 2.0, G = 3.0;
+  auto m = make_material(config("linear_elastic", {{"lambda", lambda}, {"shear_modulus", G}}));
+  Mat3 A;
+  A << 0.3, -0.5, 0.2, 0.7, -0.1, 0.4, -0.6, 0.25, 0.45;
+  for (double size : {1e-6, 1e-3, 0.01, 0.02, 0.03, 0.045, 0.06, 0.1, 0.3}) {
+    const Mat3 F = rotation(Eigen::Vector3d(1, 2, 3), 0.4) * (Mat3::Identity() + size * A);
+    const Mat3 V = Eigen::SelfAdjointEigenSolver<Mat3>(F * F.transpose()).operatorSqrt();
+    const Mat3 E = V - Mat3::Identity();  // loses about 1e-16 absolute: the tolerance below
+    const Mat3 reference = 2.0 * G * (E + E * E) + lambda * E.trace() * (Mat3::Identity() + E);
+    const Mat3 tau = m->kirchhoff(F);
+    EXPECT_LT((tau - reference).norm(), 1e-13 * reference.norm() + 1e-14) << size;
+    EXPECT_LT((tau - tau.transpose()).norm(), 1e-15 * tau.norm()) << size;
+  }
+}
+
 TEST(Materials, CorotationalLinearElasticPlanarPathMatchesTheFullOne) {
   // update_stress with planar = true (the closed-form 2x2 square root) equals kirchhoff (the
   // 3x3 eigen-decomposition) for a block-diagonal F, also after a large rotation in the plane.

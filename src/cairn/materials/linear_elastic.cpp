@@ -19,6 +19,7 @@
 // In 1D (uniaxial strain, F = diag(f, 1, 1), f > 0) the two forms are the same function:
 // tau_xx = f (f - 1)(lambda + 2G).
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <numbers>
@@ -40,6 +41,22 @@ Form parse_form(const MaterialConfig& cfg) {
   return it != cfg.strings.end() && it->second == "small_strain" ? Form::small_strain : Form::corotational;
 }
 
+/// Coefficients c_k of sqrt(1 + x) - 1 = sum_(k>=1) c_k x^k and, per degree m, the largest
+/// |D| for which the truncation after c_m is below round-off of E ~ D / 2:
+/// |c_(m+1)| |D|^m <= 5e-18 (the terms decrease geometrically for |D| < 1).
+struct SqrtSeries {
+  static constexpr int max_degree = 14;
+  std::array<double, max_degree + 2> c{};
+  std::array<double, max_degree + 1> limit{};
+  SqrtSeries() {
+    c[1] = 0.5;
+    for (int k = 1; k <= max_degree; ++k) c[k + 1] = c[k] * (0.5 - k) / (k + 1);
+    limit[0] = 0.0;
+    for (int m = 1; m <= max_degree; ++m) limit[m] = std::pow(5e-18 / std::abs(c[m + 1]), 1.0 / m);
+  }
+};
+const SqrtSeries sqrt_series;
+
 /// The Biot-type strain E = V - I of the left stretch V = sqrt(F F^T) (symmetric; det F > 0),
 /// computed from the displacement gradient H = F - I (exact: F near I) so that it keeps the
 /// precision of H however small the strain: with D = B - I = H + H^T + H H^T,
@@ -47,8 +64,9 @@ Form parse_form(const MaterialConfig& cfg) {
 ///    s = sqrt(det M), t = sqrt(tr M + 2 s) (Cayley-Hamilton for X = sqrt M: X^2 = tr(X) X -
 ///    det(X) I, tr X = t, det X = s). With s = 1 + ds and t = 2 + dt, E = (D + (ds - dt) I) / t,
 ///    dt = 2x / (1 + sqrt(1 + x)), x = (tr D + 2 ds) / 4; E_zz = |F_zz| - 1.
-///  - full F: the eigen-decomposition D = Q diag(d) Q^T (Eigen's closed form for symmetric 3x3
-///    matrices) and E = Q diag(d / (1 + sqrt(1 + d))) Q^T.
+///  - full F: for |D| up to 0.06 the binomial series of sqrt(I + D) - I in D; beyond, the
+///    eigen-decomposition D = Q diag(d) Q^T (Eigen's closed form for symmetric 3x3 matrices) and
+///    E = Q diag(d / (1 + sqrt(1 + d))) Q^T.
 Mat3 stretch_strain(const Mat3& F, bool planar) {
   const Mat3 H = F - Mat3::Identity();
   if (planar) {
@@ -65,6 +83,21 @@ Mat3 stretch_strain(const Mat3& F, bool planar) {
     return E;
   }
   const Mat3 D = H + H.transpose() + H * H.transpose();
+  // Small D (elastic strains): the binomial series sqrt(I + D) - I = sum_k c_k D^k, c_1 = 1/2,
+  // c_(k+1) = c_k (1/2 - k) / (k + 1), by Horner in D, to the degree at which the tail is below
+  // round-off of E (|D|_inf bounds the spectral radius; sqrt_series below). Eight times cheaper
+  // than the eigen-decomposition in problem (c) (docs/performance.md).
+  const double b = D.cwiseAbs().rowwise().sum().maxCoeff();
+  if (b <= sqrt_series.limit[sqrt_series.max_degree]) {
+    int m = 1;
+    while (b > sqrt_series.limit[m]) ++m;
+    Mat3 E = sqrt_series.c[m] * D;
+    for (int k = m - 1; k >= 1; --k) {
+      E.diagonal().array() += sqrt_series.c[k];
+      E = D * E;
+    }
+    return 0.5 * (E + E.transpose());  // symmetric to round-off; make it exactly so
+  }
   Eigen::SelfAdjointEigenSolver<Mat3> eigen;
   eigen.computeDirect(D);
   Eigen::Vector3d e;
