@@ -17,6 +17,9 @@ struct ElasticConstants {
   [[nodiscard]] double youngs() const { return shear * (3.0 * lambda + 2.0 * shear) / (lambda + shear); }
 };
 
+/// A string key of a [[material]] with a fixed list of choices (e.g. a model's `form`).
+KeyDecl material_choice_key(std::string name, std::string default_choice, std::vector<std::string> choices,
+                            std::string doc);
 /// The key declarations for the three pairs (none has a default).
 std::vector<KeyDecl> elastic_constant_keys();
 /// "" when exactly one complete pair is given, else a message saying what is wrong.

@@ -193,15 +193,10 @@ class LinearElastic final : public Material {
 
 MaterialModelInfo info() {
   auto keys = elastic_constant_keys();
-  KeyDecl form;
-  form.section = "material";
-  form.name = "form";
-  form.type = KeyType::string;
-  form.default_value = "\"corotational\"";
-  form.choices = [] { return std::vector<std::string>{"corotational", "small_strain"}; };
-  form.doc = "corotational: Hooke's law on the Biot strain U - I of F = R U (objective, any rotation); "
-             "small_strain: eps = sym(F) - I (seed 003 Sec. 6; not objective, warns past 5 degrees of rotation)";
-  keys.push_back(form);
+  keys.push_back(material_choice_key(
+      "form", "corotational", {"corotational", "small_strain"},
+      "corotational: Hooke's law on the Biot strain U - I of F = R U (objective, any rotation); "
+      "small_strain: eps = sym(F) - I (seed 003 Sec. 6; not objective, warns past 5 degrees of rotation)"));
   return {"isotropic linear elasticity (corotational or small-strain)", keys, &check_elastic_constants};
 }
 

@@ -16,6 +16,18 @@ std::unique_ptr<Material> make_material(const MaterialConfig& cfg) {
 
 std::vector<std::string> material_model_names() { return MaterialRegistry::instance().names(); }
 
+KeyDecl material_choice_key(std::string name, std::string default_choice, std::vector<std::string> choices,
+                            std::string doc) {
+  KeyDecl k;
+  k.section = "material";
+  k.name = std::move(name);
+  k.type = KeyType::string;
+  k.default_value = "\"" + default_choice + "\"";
+  k.choices = [choices = std::move(choices)] { return choices; };
+  k.doc = std::move(doc);
+  return k;
+}
+
 std::vector<KeyDecl> elastic_constant_keys() {
   auto modulus = [](std::string name, std::string doc) {
     KeyDecl k;

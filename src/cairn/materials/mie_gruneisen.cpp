@@ -27,6 +27,7 @@
 // State per particle: U, alpha (equivalent plastic strain), b_e (6 components).
 #include <cmath>
 
+#include "cairn/materials/elastic_constants.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/math/tensor.hpp"
 
@@ -209,14 +210,9 @@ MaterialModelInfo info() {
       key("av_a2", "artificial viscosity A2 (seed 004 Eq. 52)", "0.0"),
       key("initial_temperature", "initial temperature of the particles", "298.15"),
   };
-  KeyDecl h;
-  h.section = "material";
-  h.name = "hardening";
-  h.type = KeyType::string;
-  h.default_value = "\"linear\"";
-  h.choices = [] { return std::vector<std::string>{"linear", "power"}; };
-  h.doc = "hardening law: linear (sigma_y0 + H alpha) or power (sigma_y0 (1 + alpha/eps0)^n)";
-  keys.push_back(h);
+  keys.push_back(material_choice_key("hardening", "linear", {"linear", "power"},
+                                     "hardening law: linear (sigma_y0 + H alpha) or power (sigma_y0 (1 + "
+                                     "alpha/eps0)^n)"));
   return {"Mie-Grueneisen EOS with neo-Hookean shear, J2 plasticity, artificial viscosity and "
           "heating (seed 004 Eq. 18, 51, 52)",
           keys, nullptr};

@@ -110,15 +110,9 @@ class NeoHookean final : public Material {
 
 MaterialModelInfo info() {
   auto keys = elastic_constant_keys();
-  KeyDecl form;
-  form.section = "material";
-  form.name = "form";
-  form.type = KeyType::string;
-  form.default_value = "\"ln_j\"";
-  form.choices = [] { return std::vector<std::string>{"ln_j", "j_squared", "isochoric"}; };
-  form.doc = "strain-energy form: ln_j (seed 001 Eq. 31), j_squared (seed 000 Eq. 6), "
-             "isochoric (seed 004 Eq. 18)";
-  keys.push_back(form);
+  keys.push_back(material_choice_key("form", "ln_j", {"ln_j", "j_squared", "isochoric"},
+                                     "strain-energy form: ln_j (seed 001 Eq. 31), j_squared (seed 000 Eq. 6), "
+                                     "isochoric (seed 004 Eq. 18)"));
   return {"compressible neo-Hookean hyperelasticity", keys, &check_elastic_constants};
 }
 
