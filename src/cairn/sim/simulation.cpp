@@ -108,6 +108,37 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // update takes v+ - v, or v+ whose change the dissipation tally of the update already sees).
     contact_->count_first_correction(contact_->impulse() && contact_->corrects_extrapolation());
     contact_->set_start_velocity(&nodes_.velocity);
+    on(StepPoint::after_momentum, [this](double dt) {
+      // Contact nodes, normals and separations of this step, then the first correction
+      // p^a = p^a0 + dp^a kept as dv^a (seed 004 Eq. 26).
+      contact_->prepare(particles_, cache_, nodes_.mass);
+      // dv^a is zero wherever this step's first correction does not set it (nodes that were
+      // contact nodes last step included).
+      for_each_node(n_slots(), [&](std::int32_t i) {
+        contact_dv_[i].setZero();
+        contact_impulse_[i].setZero();
+      });
+      if (contact_->corrects_extrapolation())
+        contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, dt,
+                          &contact_dv_, contact_->impulse() ? &contact_impulse_ : nullptr);
+      const std::int32_t nn = grid_.n_nodes();
+      for_each_node(nn, [&](std::int32_t i) {
+        double m = 0.0;
+        Vec<D> q = Vec<D>::Zero();
+        for (int f = 0; f < n_fields_; ++f) {
+          m += nodes_.mass[f * nn + i];
+          q += nodes_.momentum[f * nn + i];
+        }
+        totals_.mass[i] = m;
+        totals_.momentum[i] = q;
+      });
+    });
+    on(StepPoint::before_conditions, [this](double dt) {
+      // Second correction, on the updated momenta: dp^a+ / dt is the contact force and the
+      // acceleration is (v^a+ - v^a) / dt with the corrected v^a (seed 004 Eq. 30-34).
+      contact_->correct(nodes_.mass, nodes_.velocity_new, false, Contact<D>::Pass::updated, time_, dt, nullptr);
+      contact_->reduce(distribution_.comm());
+    });
     if (contact_->xpic_correction())
       on(StepPoint::after_full_mass, [this](double) {
         // Multimaterial XPIC/FMPM: the dv term of seed 004 Eq. 37 comes after the conditions
@@ -154,6 +185,14 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   } else {
     tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
   }
+  if (!config_.tractions.empty())
+    on(StepPoint::after_forces, [this](double dt) {
+      // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
+      collectively([&] {
+        tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * dt, nodes_.force,
+                              contact_ ? &field_offset_ : nullptr);
+      });
+    });
 
   if (config_.method.integration == "wls") {
     // The WLS method (seed 001) replaces the particle transfers; features that act through

@@ -191,9 +191,11 @@ class Simulation {
   /// A distributed step's start: imbalance, repartition, migration; then ghosts, window and
   /// stencils until the stencils fit the window.
   void distribute_and_build();
-  /// Named points of the step where optional features attach (their set-up calls on()): after
+  /// Named points of the step where optional features attach (their set-up calls on()):
+  /// after the internal forces (tractions), after mass and momentum (contact's nodes, normals and
+  /// first correction), before the grid velocity conditions (contact's second correction), after
   /// the full-mass expansion (multimaterial XPIC/FMPM's contact term), at the end (conduction).
-  enum class StepPoint { after_full_mass, end_of_step };
+  enum class StepPoint { after_forces, after_momentum, before_conditions, after_full_mass, end_of_step };
   void on(StepPoint point, std::function<void(double dt)> hook) { hooks_[static_cast<int>(point)].push_back(std::move(hook)); }
   void run_hooks(StepPoint point, double dt) {
     for (const auto& hook : hooks_[static_cast<int>(point)]) hook(dt);
@@ -274,7 +276,7 @@ class Simulation {
   std::vector<char> wave_speed_varies_;   ///< Material::wave_speed_varies of material m
   const StressTiming* timing_ = nullptr;  ///< method.stress_update (sim/stress_timing.hpp)
   /// The features attached to the step's named points (StepPoint), in attachment order.
-  std::array<std::vector<std::function<void(double dt)>>, 2> hooks_;
+  std::array<std::vector<std::function<void(double dt)>>, 5> hooks_;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
   std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)

@@ -329,37 +329,8 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   };
   if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
   else extrapolate(std::false_type{});
-  // Tractions on particle faces join the grid forces (seed 000 Sec. 2.4, first equation).
-  if (forces)
-    collectively([&] {
-      tractions_.add_forces(grid_, particles_, *shape_, time_ + 0.5 * step_dt_, nodes_.force,
-                            contact_ ? &field_offset_ : nullptr);
-    });
-  if (mass_and_momentum && contact_) {
-    // Multimaterial: contact nodes, normals and separations of this step, then the first
-    // correction p^a = p^a0 + dp^a kept as dv^a (seed 004 Eq. 26).
-    contact_->prepare(particles_, cache_, nodes_.mass);
-    // dv^a is zero wherever this step's first correction does not set it (nodes that were
-    // contact nodes last step included).
-    for_each_node(n_slots(), [&](std::int32_t i) {
-      contact_dv_[i].setZero();
-      contact_impulse_[i].setZero();
-    });
-    if (contact_->corrects_extrapolation())
-      contact_->correct(nodes_.mass, nodes_.momentum, true, Contact<D>::Pass::extrapolated, time_, step_dt_,
-                        &contact_dv_, contact_->impulse() ? &contact_impulse_ : nullptr);
-    const std::int32_t nn = grid_.n_nodes();
-    for_each_node(nn, [&](std::int32_t i) {
-      double m = 0.0;
-      Vec<D> q = Vec<D>::Zero();
-      for (int f = 0; f < n_fields_; ++f) {
-        m += nodes_.mass[f * nn + i];
-        q += nodes_.momentum[f * nn + i];
-      }
-      totals_.mass[i] = m;
-      totals_.momentum[i] = q;
-    });
-  }
+  if (forces) run_hooks(StepPoint::after_forces, step_dt_);
+  if (mass_and_momentum) run_hooks(StepPoint::after_momentum, step_dt_);
 }
 
 template <int D>
@@ -382,12 +353,7 @@ void Simulation<D>::update_grid(double dt) {
       nodes_.velocity_new[i].setZero();
     }
   });
-  // Second contact correction, on the updated momenta: dp^a+ / dt is the contact force and the
-  // acceleration is (v^a+ - v^a) / dt with the corrected v^a (seed 004 Eq. 30-34).
-  if (contact_) {
-    contact_->correct(nodes_.mass, nodes_.velocity_new, false, Contact<D>::Pass::updated, time_, dt, nullptr);
-    contact_->reduce(distribution_.comm());
-  }
+  run_hooks(StepPoint::before_conditions, dt);
   for (int f = 0; f < n_fields_; ++f) {
     const std::int32_t off = f * grid_.n_nodes();
     conditions_.apply_step(nodes_, dt, off);
