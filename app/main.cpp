@@ -119,7 +119,7 @@ constexpr const char* threads_help =
     "OpenMP threads, 0..1024 (0 or absent: OMP_NUM_THREADS, else all cores up to the CPU limit of the "
     "control group)";
 
-/// Largest -t: as simulation.threads (io/schema.cpp).
+/// Largest -t: as simulation.threads (input/schema.cpp).
 constexpr int max_threads = 1024;
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The validated, resolved input of one simulation. Filled only by load_config() (io/input.hpp),
+// The validated, resolved input of one simulation. Filled only by load_config() (input/input.hpp),
 // which has checked every key against its declaration; the rest of Cairn trusts these values.
 #pragma once
 
@@ -40,7 +40,7 @@ struct SimulationConfig {
   int threads = 0;          ///< 0: OpenMP default
   bool adapt_threads = true;  ///< pick all threads or one from measured step times
   bool sort_particles = true;  ///< keep large runs' particles in memory in cell-block order
-  std::string units = "SI"; ///< declared unit system (labels the output; io/units.hpp)
+  std::string units = "SI"; ///< declared unit system (labels the output; config/units.hpp)
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
   double rebalance_threshold = 0.25;  ///< MPI: repartition when max/mean particles - 1 exceeds it
   double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check

@@ -64,7 +64,7 @@ class InputError : public std::runtime_error {
   std::string found_;
 };
 
-/// Several independent mistakes of one input, found in one reading (io/input.cpp: a key that is
+/// Several independent mistakes of one input, found in one reading (input/input.cpp: a key that is
 /// declared nowhere in its table, or one whose bad value can give way to its default, does not
 /// stop the reading; the first error that leaves the rest unreadable does). The InputError base
 /// is the first of them, so a handler of InputError sees what it always saw; errors() has them

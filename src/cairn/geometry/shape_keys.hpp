@@ -1,5 +1,5 @@
 // The [[body]] shape kinds of the geometry room and their keys (sections "body.shape.<kind>"),
-// declared beside the readers that use them; io/schema.cpp adds them to the input's declarations.
+// declared beside the readers that use them; input/schema.cpp adds them to the input's declarations.
 #pragma once
 
 #include <string>

@@ -1,6 +1,6 @@
 // Reading an input file: TOML text + `--set` overrides -> a validated, fully resolved Config.
 //
-// Every key is checked against its declaration (io/schema.hpp): unknown keys, wrong types,
+// Every key is checked against its declaration (input/schema.hpp): unknown keys, wrong types,
 // out-of-range values, bad choices and inconsistent combinations all throw InputError naming the
 // file and line (or the `--set` text), the key, what was expected and what was found.
 #pragma once

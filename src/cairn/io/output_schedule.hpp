@@ -1,6 +1,6 @@
 #pragma once
 // When a run writes its outputs: history rows, snapshots and checkpoints on the intervals of
-// [output] (docs/output.md). Shared by the MPM run loop (sim/run.cpp) and the reference FEM's
+// [output] (docs/output.md). Shared by the MPM run loop (run/mpm_engine.cpp) and the reference FEM's
 // (fem/run.cpp), so that both write at the same times and restart the same way.
 
 #include <algorithm>

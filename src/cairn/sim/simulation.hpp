@@ -1,6 +1,6 @@
 // Simulation<D>: owns the state of one run (grid, node fields, particles, materials, transfer
 // cache) and advances it by explicit steps. The step is a list of named stages that follow seed
-// 000 Table 1; the run loop with outputs lives in sim/run.hpp.
+// 000 Table 1; the run loop with outputs lives in run/engine.hpp.
 #pragma once
 
 #include <array>
