@@ -136,6 +136,20 @@ bool Engine::finished() const {
   return !(time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || step_count() < s.max_steps));
 }
 
+void Engine::stop_after_step(int signal_number, const std::filesystem::path& folder) {
+  flush();
+  const char* name = signal_number == SIGINT    ? "SIGINT"
+                     : signal_number == SIGTERM ? "SIGTERM"
+                                                : "a signal";
+  std::string saved = "no checkpoint written (output.checkpoints = false)";
+  if (config().output.checkpoints) {
+    const std::filesystem::path checkpoint = write_checkpoint(true);
+    saved = fmt::format("state saved in {0}; continue with: cairn restart {0}", checkpoint.string());
+  }
+  throw RunInterrupted(fmt::format("interrupted by {} at step {} (t = {:.6g}); {}; output in {}", name, step_count(),
+                                   time(), saved, folder.string()));
+}
+
 void request_stop(int signal_number) { stop_signal = signal_number; }
 int requested_stop() { return stop_signal; }
 void clear_stop_request() { stop_signal = 0; }

@@ -58,6 +58,12 @@ class Engine {
   /// history.csv up to date on disk.
   virtual void flush() = 0;
   [[nodiscard]] virtual EngineState state() = 0;
+
+ protected:
+  /// A stop asked for during the step just taken (request_stop, on any rank): history.csv to
+  /// disk, checkpoint-autosave.h5 (unless output.checkpoints is false), and the RunInterrupted
+  /// that says where the state is and how to go on.
+  [[noreturn]] void stop_after_step(int signal_number, const std::filesystem::path& folder);
 };
 
 /// Ask a running engine to stop after its current step (async-signal-safe: the CLI's SIGINT and

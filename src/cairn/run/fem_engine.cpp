@@ -86,7 +86,7 @@ class FemEngine final : public Engine {
     last_dt_ = dt;
     schedule_.after_step(
         solver_.time(), [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint(); });
-    if (const int signo = requested_stop(); signo != 0) interrupted(signo);
+    if (const int signo = requested_stop(); signo != 0) stop_after_step(signo, dir_);
   }
 
   RunSummary finish() override {
@@ -151,18 +151,6 @@ class FemEngine final : public Engine {
     snapshots_.write(solver_);
   }
 
-  /// SIGINT/SIGTERM: keep the history, save the state, say where, and stop.
-  [[noreturn]] void interrupted(int signo) {
-    history_writer_.flush();
-    const char* name = signo == SIGINT ? "SIGINT" : signo == SIGTERM ? "SIGTERM" : "a signal";
-    std::string saved = "no checkpoint written (output.checkpoints = false)";
-    if (config_.output.checkpoints) {
-      write_checkpoint(true);
-      saved = fmt::format("state saved in {0}; continue with: cairn restart {0}", last_checkpoint_.string());
-    }
-    throw RunInterrupted(fmt::format("interrupted by {} at step {} (t = {:.6g}); {}; output in {}", name,
-                                     solver_.step_count(), solver_.time(), saved, dir_.string()));
-  }
 
   [[noreturn]] void fail(const SimulationFailure& f) {
     history_writer_.flush();

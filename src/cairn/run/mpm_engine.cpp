@@ -265,7 +265,7 @@ class MpmEngine final : public Engine {
       write_checkpoint(true);
       last_autosave_ = Clock::now();
     }
-    if (decide[1] != 0) interrupted(static_cast<int>(decide[1]));
+    if (decide[1] != 0) stop_after_step(static_cast<int>(decide[1]), dir_);
   }
 
   RunSummary finish() override {
@@ -465,18 +465,6 @@ class MpmEngine final : public Engine {
     if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
   }
 
-  /// SIGINT/SIGTERM: keep the history, save the state, say where, and stop.
-  [[noreturn]] void interrupted(int signo) {
-    flush_history();
-    const char* name = signo == SIGINT ? "SIGINT" : signo == SIGTERM ? "SIGTERM" : "a signal";
-    std::string saved = "no checkpoint written (output.checkpoints = false)";
-    if (config_.output.checkpoints) {
-      write_checkpoint(true);
-      saved = fmt::format("state saved in {0}; continue with: cairn restart {0}", last_checkpoint_.string());
-    }
-    throw RunInterrupted(fmt::format("interrupted by {} at step {} (t = {:.6g}); {}; output in {}", name,
-                                     sim_.step_count(), sim_.time(), saved, dir_.string()));
-  }
 
   /// The step from sim_.time() by dt failed: write its state, stamped with its own step and time.
   [[noreturn]] void fail(const SimulationFailure& f, double dt) {
