@@ -12,6 +12,7 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <regex>
 
 #include "cairn/bc/expression.hpp"
@@ -24,6 +25,7 @@
 #include "cairn/io/input.hpp"
 #include "cairn/io/output_schedule.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/sim/engine.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/sim/thread_tuner.hpp"
@@ -246,40 +248,13 @@ class Runner {
     return notes;
   }
 
+  /// The run from where it stands to its end: the loop of `cairn run`, with autosaves every
+  /// output.checkpoint_wall_interval and a checkpoint on SIGINT/SIGTERM.
   RunSummary run() {
     const StopSignals signals;
-    const auto start = Clock::now();
-    last_autosave_ = start;
-    const long long first_step = sim_.step_count();
-    const auto& s = config_.simulation;
-    n_particles_ = sim_.total_particles();
-    if (!restarted_) {
-      clear_earlier_outputs();
-      if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
-        std::fprintf(stderr, "cairn: %s\n", note.c_str());
-      initial_energy_ = energy();
-      measure_error();
-      write_history_row();
-      write_snapshot();
-    }
-    ThreadTuner tuner(omp_get_max_threads(), s.adapt_threads, &ThreadTuner::runnable_others);
-    while (sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps)) {
-      tuner.before_step();
-      const auto step_start = Clock::now();
-      const double dt = sim_.next_dt();
-      try {
-        sim_.step(dt);
-      } catch (const SimulationFailure& f) {
-        fail(f, dt);
-      }
-      tuner.after_step(std::chrono::duration<double>(Clock::now() - step_start).count());
-      last_dt_ = dt;
-      max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
-      measure_error();
-      for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
-      const double t = sim_.time();
-      schedule_.after_step(
-          t, [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint_file(); });
+    begin();
+    while (!finished()) {
+      step_once();
       const double wall_interval = config_.output.checkpoint_wall_interval;
       // On several ranks the autosave and the stop are decided together (any rank's clock or
       // signal), so that every rank writes the same checkpoint and stops at the same step.
@@ -292,19 +267,72 @@ class Runner {
         last_autosave_ = Clock::now();
       }
       if (decide[1] != 0) interrupted(static_cast<int>(decide[1]));
-      progress(start, first_step);
+      progress(start_, first_step_);
     }
-    tuner.finish();
+    return end();
+  }
+
+  // ---- the run in pieces (run() above; the Python module's Engine, sim/engine.hpp) ----------
+  /// The initial outputs of a new run (none for a restart), the clocks and the thread tuner.
+  void begin() {
+    if (tuner_) return;
+    start_ = Clock::now();
+    last_autosave_ = start_;
+    first_step_ = sim_.step_count();
+    n_particles_ = sim_.total_particles();
+    if (!restarted_) {
+      clear_earlier_outputs();
+      if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
+        std::fprintf(stderr, "cairn: %s\n", note.c_str());
+      initial_energy_ = energy();
+      measure_error();
+      write_history_row();
+      write_snapshot();
+    }
+    tuner_ = std::make_unique<ThreadTuner>(omp_get_max_threads(), config_.simulation.adapt_threads,
+                                           &ThreadTuner::runnable_others);
+  }
+
+  [[nodiscard]] bool finished() const {
+    const auto& s = config_.simulation;
+    return !(sim_.time() < s.end_time * (1.0 - 1e-12) && (s.max_steps == 0 || sim_.step_count() < s.max_steps));
+  }
+
+  /// One step and the history rows, snapshots and checkpoints its schedule asks for.
+  void step_once() {
+    begin();
+    tuner_->before_step();
+    const auto step_start = Clock::now();
+    const double dt = sim_.next_dt();
+    try {
+      sim_.step(dt);
+    } catch (const SimulationFailure& f) {
+      fail(f, dt);
+    }
+    tuner_->after_step(std::chrono::duration<double>(Clock::now() - step_start).count());
+    last_dt_ = dt;
+    max_imbalance_ = std::max(max_imbalance_, sim_.imbalance());
+    measure_error();
+    for (const auto& note : sim_.take_notes()) std::fprintf(stderr, "cairn: %s\n", note.c_str());  // rank 0's
+    const double t = sim_.time();
+    schedule_.after_step(
+        t, [&] { write_history_row(); }, [&] { write_snapshot(); }, [&] { write_checkpoint_file(); });
+  }
+
+  /// The final history row, snapshot and checkpoint; the summary.
+  RunSummary end() {
+    begin();
+    tuner_->finish();
     schedule_.at_end([&] { write_history_row(); }, [&] { write_snapshot(); });
     flush_history();
     if (config_.output.checkpoints) write_checkpoint_file();
-    progress(start, first_step, true);
+    progress(start_, first_step_, true);
     finish_progress();
 
     RunSummary summary;
-    summary.steps = sim_.step_count() - first_step;
+    summary.steps = sim_.step_count() - first_step_;
     summary.end_time = sim_.time();
-    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    summary.wall_seconds = std::chrono::duration<double>(Clock::now() - start_).count();
     summary.n_particles = static_cast<std::size_t>(n_particles_);
     summary.body_notes = mesh_volume_notes();
     summary.ranks = comm_.size();
@@ -316,8 +344,8 @@ class Runner {
     summary.output_directory = dir_;
     summary.last_checkpoint = last_checkpoint_;
     summary.stage_seconds = sim_.stage_times();
-    summary.adaptive_threads = tuner.enabled();
-    summary.single_thread_steps = tuner.single_thread_steps();
+    summary.adaptive_threads = tuner_->enabled();
+    summary.single_thread_steps = tuner_->single_thread_steps();
     summary.particle_sorts = sim_.particle_sorts();
     if (const auto* c = sim_.contact()) {
       summary.contact_prepare_seconds = c->prepare_seconds();
@@ -326,6 +354,16 @@ class Runner {
       summary.contact_node_steps = c->node_steps();
     }
     return summary;
+  }
+
+  Simulation<D>& simulation() { return sim_; }
+  [[nodiscard]] const Simulation<D>& simulation() const { return sim_; }
+  [[nodiscard]] const Config& config() const { return config_; }
+  [[nodiscard]] std::int64_t n_particles() const { return sim_.total_particles(); }
+  void flush() { flush_history(); }
+  std::filesystem::path checkpoint(bool autosave) {
+    write_checkpoint_file(autosave);
+    return last_checkpoint_;
   }
 
  private:
@@ -594,6 +632,9 @@ class Runner {
   double last_progress_time_ = 0.0;
   double smoothed_speed_ = 0.0;  ///< simulated time per wall second, smoothed
   Clock::time_point last_autosave_{};
+  Clock::time_point start_{};  ///< begin()
+  long long first_step_ = 0;   ///< the step begin() found
+  std::unique_ptr<ThreadTuner> tuner_;  ///< made by begin()
   int last_decile_ = 0;
   bool progress_shown_ = false;
 };
@@ -624,6 +665,46 @@ std::string time_step_note(const Config& config) {
       "cfl = {} may be unstable; cfl <= {:.2g} keeps cfl * sqrt(k) <= {} (seed 000 uses 0.2; measured "
       "limits in docs/update-schemes.md)",
       k, cfl, max_cfl, limit);
+}
+
+namespace {
+/// A new MPM or WLS run as an Engine (sim/engine.hpp): the Runner's pieces, without the signal
+/// handlers and the autosave clock of `cairn run`, which belong to whoever drives the engine.
+template <int D>
+class RunnerEngine final : public Engine {
+ public:
+  RunnerEngine(const Config& config, const RunOptions& options) : runner_(config, options) {}
+  [[nodiscard]] std::string name() const override {
+    return runner_.config().method.integration == "wls" ? "wls" : "mpm";
+  }
+  [[nodiscard]] int dimension() const override { return D; }
+  [[nodiscard]] const Config& config() const override { return runner_.config(); }
+  [[nodiscard]] double time() const override { return runner_.simulation().time(); }
+  [[nodiscard]] long long step_count() const override { return runner_.simulation().step_count(); }
+  [[nodiscard]] double end_time() const override { return runner_.config().simulation.end_time; }
+  [[nodiscard]] bool finished() const override { return runner_.finished(); }
+  void start() override { runner_.begin(); }
+  void step() override { runner_.step_once(); }
+  RunSummary finish() override { return runner_.end(); }
+  std::filesystem::path write_checkpoint(bool autosave) override { return runner_.checkpoint(autosave); }
+  void flush() override { runner_.flush(); }
+  EngineState state() override { return &runner_.simulation(); }
+  [[nodiscard]] std::int64_t items() const override { return runner_.n_particles(); }
+
+ private:
+  Runner<D> runner_;
+};
+}  // namespace
+
+std::unique_ptr<Engine> make_engine(const Config& config, const RunOptions& options) {
+  if (config.fem.enabled)
+    throw std::invalid_argument(config.source_file + ": [fem] runs are not yet driven through the engine "
+                                "interface (cairn run only)");
+  switch (config.simulation.dimension) {
+    case 1: return std::make_unique<RunnerEngine<1>>(config, options);
+    case 2: return std::make_unique<RunnerEngine<2>>(config, options);
+    default: return std::make_unique<RunnerEngine<3>>(config, options);
+  }
 }
 
 namespace {
