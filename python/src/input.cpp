@@ -40,11 +40,12 @@ std::unique_ptr<toml::node> to_node(py::handle value, const std::string& where, 
   if (py::isinstance<py::dict>(value)) return to_table(value, where, depth);
   if (py::isinstance<py::str>(value)) return std::make_unique<toml::value<std::string>>(value.cast<std::string>());
   if (py::isinstance<py::int_>(value) || (py::hasattr(value, "__index__") && !py::isinstance<py::float_>(value)))
-    return std::make_unique<toml::value<std::int64_t>>(py::int_(value).cast<std::int64_t>());
+    return std::make_unique<toml::value<std::int64_t>>(value.cast<std::int64_t>());
   if (py::isinstance<py::float_>(value) || py::hasattr(value, "__float__"))
-    return std::make_unique<toml::value<double>>(py::float_(value).cast<double>());
+    return std::make_unique<toml::value<double>>(value.cast<double>());
   if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) || py::hasattr(value, "tolist")) {
-    py::list items = py::hasattr(value, "tolist") ? py::list(value.attr("tolist")()) : py::list(value);
+    const py::object sequence = py::hasattr(value, "tolist") ? value.attr("tolist")() : py::reinterpret_borrow<py::object>(value);
+    const py::list items(sequence);
     auto array = std::make_unique<toml::array>();
     int i = 0;
     for (const auto& item : items) {
