@@ -5,6 +5,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -32,6 +34,38 @@ py::array view(T* data, std::size_t n, std::size_t item, const Shape& tail, cons
 }
 
 constexpr py::ssize_t d8 = sizeof(double);
+
+/// Where each material keeps the state variable `name` (-1: it has none).
+template <int D>
+std::vector<int> state_indices(const Simulation<D>& sim, const std::string& name) {
+  std::vector<int> index;
+  for (const auto& m : sim.materials()) {
+    index.push_back(-1);
+    for (const auto& v : m->state_variables())
+      if (v.name == name) index.back() = v.index;
+  }
+  return index;
+}
+
+/// A material state variable (Material::state_variables): a view of its column of the state
+/// array when every material keeps it in the same place, else a read-only copy with NaN for the
+/// particles whose material has no such variable.
+template <int D>
+py::object state_variable_array(Simulation<D>& sim, const py::object& base, const std::vector<int>& index) {
+  auto& P = sim.particles();
+  const std::size_t n = P.n(), width = static_cast<std::size_t>(P.n_state_per_particle);
+  if (std::all_of(index.begin(), index.end(), [&](int k) { return k == index.front(); }))
+    return view(P.state.data() + index.front(), n, width * sizeof(double), {}, {}, base, false);
+  py::array_t<double> copy(static_cast<py::ssize_t>(n));
+  auto out = copy.mutable_unchecked<1>();
+  for (std::size_t p = 0; p < n; ++p) {
+    const int k = index[static_cast<std::size_t>(P.material[p])];
+    out(static_cast<py::ssize_t>(p)) = k >= 0 ? P.state[p * width + static_cast<std::size_t>(k)]
+                                              : std::numeric_limits<double>::quiet_NaN();
+  }
+  py::detail::array_proxy(copy.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return copy;
+}
 
 template <int D>
 py::object particle_array_of(Simulation<D>& sim, const py::object& base, const std::string& name, bool writable) {
@@ -64,6 +98,9 @@ py::object particle_array_of(Simulation<D>& sim, const py::object& base, const s
     const auto k = static_cast<py::ssize_t>(P.n_state_per_particle);
     return view(P.state.data(), n, static_cast<std::size_t>(k) * sizeof(double), {k}, {d8}, base, writable);
   }
+  if (const auto index = state_indices(sim, name);
+      !writable && std::any_of(index.begin(), index.end(), [](int k) { return k >= 0; }))
+    return state_variable_array(sim, base, index);
   throw std::invalid_argument("no particle array '" + name + "' in this run");
 }
 
@@ -76,6 +113,9 @@ std::vector<std::string> particle_fields_of(const Simulation<D>& sim) {
   if (P.has_temperature) names.push_back("temperature");
   names.insert(names.end(), {"material", "body", "id"});
   if (P.n_state_per_particle > 0) names.push_back("state");
+  for (const auto& m : sim.materials())
+    for (const auto& v : m->state_variables())
+      if (std::find(names.begin(), names.end(), v.name) == names.end()) names.push_back(v.name);
   return names;
 }
 
