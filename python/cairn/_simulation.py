@@ -3,6 +3,7 @@ import math
 import os
 import shutil
 import tempfile
+import warnings
 
 import numpy as np
 
@@ -102,10 +103,24 @@ class Simulation:
 
     def __init__(self, config, _temporary=None):
         """Use the from_* constructors; ``config`` is a validated ``cairn._cairn.Config``."""
-        self._engine = _cairn.Engine(config)
         self._temporary = _temporary
         self._summary = None
+        self._engine = _cairn.Engine(config)
         self.particles = Particles(self._engine)
+        for warning in config.warnings:  # as `cairn run` prints them
+            warnings.warn(warning, stacklevel=3)
+
+    @classmethod
+    def _make(cls, load, set, output):
+        """A simulation of the config `load(overrides)` returns; a temporary output folder made
+        for it is removed again when the input or the set-up is refused."""
+        overrides, temporary = _output_overrides(set, output)
+        try:
+            return cls(load(overrides), temporary)
+        except BaseException:
+            if temporary is not None:
+                shutil.rmtree(temporary, ignore_errors=True)
+            raise
 
     # ---- construction --------------------------------------------------------------------------
     @classmethod
@@ -116,14 +131,12 @@ class Simulation:
         ``output``: None (the input's output.directory, by default out/<input stem> beside the
         input), a folder, or False for a temporary folder removed by ``close()``.
         """
-        overrides, temporary = _output_overrides(set, output)
-        return cls(_cairn.load_config(os.fspath(path), overrides), temporary)
+        return cls._make(lambda overrides: _cairn.load_config(os.fspath(path), overrides), set, output)
 
     @classmethod
     def from_text(cls, text, name="input.toml", set=None, output=None):
         """As from_toml for TOML text; ``name`` stands for the file name in error messages."""
-        overrides, temporary = _output_overrides(set, output)
-        return cls(_cairn.load_config_string(text, name, overrides), temporary)
+        return cls._make(lambda overrides: _cairn.load_config_string(text, name, overrides), set, output)
 
     @classmethod
     def from_dict(cls, config, name="dict", set=None, output=None):
@@ -253,7 +266,7 @@ class Simulation:
 
     def close(self):
         """Remove the temporary output folder of ``output=False`` (nothing else)."""
-        if self._temporary is not None:
+        if getattr(self, "_temporary", None) is not None:
             shutil.rmtree(self._temporary, ignore_errors=True)
             self._temporary = None
 

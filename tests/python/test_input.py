@@ -74,3 +74,12 @@ def test_keys_are_the_declared_keys():
     assert "material[neo_hookean].shear_modulus" in keys
     cli = subprocess.run([str(BINARY), "keys"], capture_output=True, text=True, check=True)
     assert cairn.keys_text() == cli.stdout
+
+
+def test_a_refused_input_leaves_no_temporary_folder(tmp_path, monkeypatch):
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    d = two_blocks_dict()
+    d["grid"]["cell_size"] = -1.0
+    with pytest.raises(cairn.InputError):
+        cairn.Simulation.from_dict(d, output=False)
+    assert list(tmp_path.iterdir()) == []
