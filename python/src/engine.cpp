@@ -72,7 +72,7 @@ class PyEngine {
   void refuse_finished() const {
     if (finished_)
       throw std::logic_error("this run has finished (its final outputs are written); make a new Simulation, or "
-                             "continue from its checkpoint with cairn.Simulation.restart");
+                             "continue from its last checkpoint with cairn restart");
   }
 
   std::unique_ptr<Engine> engine_;

@@ -119,3 +119,10 @@ def test_build_information():
     assert cairn.__version__
     assert set(cairn.build) >= {"mpi", "openmp"}
     assert cairn.threads() >= 1
+
+
+def test_help_shows_the_docstrings():
+    import pydoc
+    text = pydoc.render_doc(cairn.Simulation)
+    for phrase in ("from_dict", "KeyboardInterrupt", "writable", "every"):
+        assert phrase in text, phrase
