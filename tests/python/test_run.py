@@ -126,3 +126,11 @@ def test_help_shows_the_docstrings():
     text = pydoc.render_doc(cairn.Simulation)
     for phrase in ("from_dict", "KeyboardInterrupt", "writable", "every"):
         assert phrase in text, phrase
+
+
+def test_several_mpi_ranks_are_refused_clearly():
+    import os
+    import sys
+    env = dict(os.environ, OMPI_COMM_WORLD_SIZE="2")
+    r = subprocess.run([sys.executable, "-c", "import cairn"], capture_output=True, text=True, env=env)
+    assert r.returncode != 0 and "one MPI rank" in r.stderr and "mpirun -np N cairn run" in r.stderr
