@@ -93,7 +93,8 @@ class Simulation:
     and raises ``cairn.InputError`` (file, line, key, expected, found) for a bad one.
 
     Then ``run()`` to the end (or ``run(until=t)``), or ``step(n)``; ``time``, ``steps``,
-    ``particles`` (NumPy views), ``grid()``, ``history()``, ``write_checkpoint()``. The outputs
+    ``particles`` (NumPy views of the engine's arrays, read-only; ``particles.writable(name)``
+    for velocity and temperature), ``grid()``, ``history()``, ``write_checkpoint()``. The outputs
     (history.csv, snapshots, checkpoints) go to ``output_directory``, as the CLI writes them.
     Ctrl-C during ``run`` or ``step`` raises KeyboardInterrupt after the current step; the
     simulation stays usable.
