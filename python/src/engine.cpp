@@ -92,10 +92,10 @@ void bind_engine(py::module_& m) {
       .def_property_readonly("finished", [](PyEngine& e) { return e.closed() || e.engine().finished(); })
       .def_property_readonly("closed", &PyEngine::closed)
       .def_property_readonly("name", [](PyEngine& e) { return e.engine().name(); })
-      .def_property_readonly("dimension", [](PyEngine& e) { return e.engine().dimension(); })
+      .def_property_readonly("dimension", [](PyEngine& e) { return e.engine().config().simulation.dimension; })
       .def_property_readonly("time", [](PyEngine& e) { return e.engine().time(); })
       .def_property_readonly("steps", [](PyEngine& e) { return e.engine().step_count(); })
-      .def_property_readonly("end_time", [](PyEngine& e) { return e.engine().end_time(); })
+      .def_property_readonly("end_time", [](PyEngine& e) { return e.engine().config().simulation.end_time; })
       .def_property_readonly("items", [](PyEngine& e) { return e.engine().items(); })
       .def_property_readonly("config", [](PyEngine& e) -> const Config& { return e.engine().config(); },
                              py::return_value_policy::reference_internal)
