@@ -12,6 +12,12 @@ process start, imports and set-up, the same in both, are left out and the Python
 (a GIL release and a signal check per step, Python calls per step for the loop) is in. Prints per
 round the three times and the ratios to the CLI of the same round, then the medians of the
 per-round ratios.
+
+The rounds are only as steady as the machine: a compile beside them scatters the ratios by
++-30 %. `--overhead` measures the Python loop's own cost without that noise: a tiny 1D run (6
+particles, about 12 us a step) stepped 20000 times in one call and by a `sim.step()` loop, in one
+process; the difference per step, set against the two-block example's step (about 2 ms), bounds
+what the loop can add.
 """
 import argparse
 import os
@@ -51,14 +57,51 @@ def python(args, out, how):
     return float(r.stdout.split()[1])
 
 
+OVERHEAD = r"""
+import sys, time, cairn
+d = {"simulation": {"dimension": 1, "end_time": 2000.0, "cfl": 0.5, "max_steps": 20000},
+     "grid": {"origin": [0.0], "extent": [1.0], "cell_size": 0.1},
+     "material": [{"name": "m", "model": "linear_elastic", "density": 1.0, "youngs_modulus": 1.0,
+                   "poissons_ratio": 0.0}],
+     "body": [{"name": "b", "material": "m", "shape": {"box": {"min": [0.2], "max": [0.8]}},
+               "particles_per_cell": 1}],
+     "output": {"every": 0.0, "history_every": 0.0, "checkpoints": False}}
+for rep in range(int(sys.argv[1])):
+    one = cairn.Simulation.from_dict(d, output=False)
+    t = time.perf_counter(); n = one.step(20000); t_one = (time.perf_counter() - t) / n
+    loop = cairn.Simulation.from_dict(d, output=False)
+    t = time.perf_counter()
+    while not loop.finished:
+        loop.step()
+    t_loop = (time.perf_counter() - t) / loop.steps
+    print(f"{t_one * 1e6:.2f} {t_loop * 1e6:.2f}")
+    one.close(); loop.close()
+"""
+
+
+def overhead(args):
+    env = dict(os.environ, PYTHONPATH=str(Path(args.cairn).resolve().parent / "python"))
+    r = subprocess.run([sys.executable, "-c", OVERHEAD, str(args.rounds)], capture_output=True, text=True,
+                       check=True, env=env)
+    rows = [tuple(map(float, line.split())) for line in r.stdout.split("\n") if line.strip()]
+    print("one call (us/step)   step() loop (us/step)   difference")
+    for one, loop in rows:
+        print(f"{one:18.2f}   {loop:21.2f}   {loop - one:10.2f}")
+    print(f"median difference: {statistics.median(loop - one for one, loop in rows):.2f} us per step")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--rounds", type=int, default=7)
     p.add_argument("--threads", type=int, default=1, help="OMP_NUM_THREADS of every run")
     p.add_argument("--end-time", type=float, default=1.8e-3)
     p.add_argument("--cairn", default=str(ROOT / "build" / "release" / "cairn"))
+    p.add_argument("--overhead", action="store_true", help="the step() loop's own cost per step (see above)")
     args = p.parse_args()
     os.environ["OMP_NUM_THREADS"] = str(args.threads)
+    if args.overhead:
+        overhead(args)
+        return
     kinds = ["cli", "run", "step"]
     ratios = {"run": [], "step": []}
     with tempfile.TemporaryDirectory() as tmp:
