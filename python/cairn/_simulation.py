@@ -102,18 +102,18 @@ class Simulation:
 
     WRITABLE = WRITABLE
 
-    def __init__(self, config, _temporary=None):
-        """Use the from_* constructors; ``config`` is a validated ``cairn._cairn.Config``."""
+    def __init__(self, engine, _temporary=None):
+        """Use the from_* constructors and restart; ``engine`` is a ``cairn._cairn.Engine``."""
         self._temporary = _temporary
         self._summary = None
-        self._engine = _cairn.Engine(config)
+        self._engine = engine
         self.particles = Particles(self._engine)
-        for warning in config.warnings:  # as `cairn run` prints them
+        for warning in engine.config.warnings:  # as `cairn run` prints them
             warnings.warn(warning, stacklevel=3)
 
     @classmethod
     def _make(cls, load, set, output):
-        """A simulation of the config `load(overrides)` returns; a temporary output folder made
+        """A simulation of the engine `load(overrides)` makes; a temporary output folder made
         for it is removed again when the input or the set-up is refused."""
         overrides, temporary = _output_overrides(set, output)
         try:
@@ -132,12 +132,14 @@ class Simulation:
         ``output``: None (the input's output.directory, by default out/<input stem> beside the
         input), a folder, or False for a temporary folder removed by ``close()``.
         """
-        return cls._make(lambda overrides: _cairn.load_config(os.fspath(path), overrides), set, output)
+        return cls._make(lambda overrides: _cairn.Engine(_cairn.load_config(os.fspath(path), overrides)), set,
+                         output)
 
     @classmethod
     def from_text(cls, text, name="input.toml", set=None, output=None):
         """As from_toml for TOML text; ``name`` stands for the file name in error messages."""
-        return cls._make(lambda overrides: _cairn.load_config_string(text, name, overrides), set, output)
+        return cls._make(lambda overrides: _cairn.Engine(_cairn.load_config_string(text, name, overrides)), set,
+                         output)
 
     @classmethod
     def from_dict(cls, config, name="dict", set=None, output=None):
@@ -155,6 +157,15 @@ class Simulation:
         input file called ``name``; line numbers in errors refer to that text.
         """
         return cls.from_text(_cairn.to_toml(config), name=name, set=set, output=output)
+
+    @classmethod
+    def restart(cls, checkpoint, set=None, output=None):
+        """Continue the run a checkpoint holds, as ``cairn restart checkpoint --set ...``: ``set``
+        may change only what steers the continuation (end time, step limit, threads, output
+        intervals and folder); the outputs go beside the checkpoint unless ``output`` says where.
+        Without changes the continuation ends bit-identical to the run that never stopped."""
+        return cls._make(lambda overrides: _cairn.Engine.restore(os.fspath(checkpoint), _cairn.overrides(overrides)),
+                         set, output)
 
     # ---- state ---------------------------------------------------------------------------------
     @property

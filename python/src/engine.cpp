@@ -6,6 +6,7 @@
 #include <chrono>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
@@ -20,6 +21,7 @@ using Clock = std::chrono::steady_clock;
 class PyEngine {
  public:
   explicit PyEngine(const Config& config) : engine_(make_engine(config, RunOptions{.quiet = true})) {}
+  explicit PyEngine(std::unique_ptr<Engine> engine) : engine_(std::move(engine)) {}
 
   /// Steps until `max_steps` are taken, the time reaches `until`, the run is finished or
   /// `wall_seconds` have passed (0: no limit); at least one step unless one of the first three
@@ -85,6 +87,12 @@ void bind_engine(py::module_& m) {
   py::register_exception<RunFailure>(m, "RunFailure", PyExc_RuntimeError);
   py::class_<PyEngine>(m, "Engine", "One run of one engine (sim/engine.hpp); use cairn.Simulation.")
       .def(py::init<const Config&>(), py::arg("config"))
+      .def_static(
+          "restore",
+          [](const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides) {
+            return std::make_unique<PyEngine>(restore_engine(checkpoint, overrides, RunOptions{.quiet = true}));
+          },
+          py::arg("checkpoint"), py::arg("overrides"), "Continue from a checkpoint, as `cairn restart`.")
       .def("advance", &PyEngine::advance, py::arg("max_steps") = 1,
            py::arg("until") = std::numeric_limits<double>::infinity(), py::arg("wall_seconds") = 0.0)
       .def("start", [](PyEngine& e) { e.engine().start(); })

@@ -163,3 +163,20 @@ def test_threads_as_the_cli():
     import os
     if "OMP_NUM_THREADS" in os.environ:
         assert cairn.threads() == int(os.environ["OMP_NUM_THREADS"])
+
+
+def test_restart_from_python_ends_bit_identical(two_blocks, tmp_path):
+    whole = cairn.Simulation.from_toml(two_blocks, output=tmp_path / "whole")
+    whole.run(progress=False)
+    first = cairn.Simulation.from_toml(two_blocks, output=tmp_path / "split")
+    first.run(until=1e-4, progress=False)
+    checkpoint = first.write_checkpoint()
+    del first
+    second = cairn.Simulation.restart(checkpoint)
+    assert second.time == pytest.approx(1e-4, abs=5e-6) and second.output_directory == str(tmp_path / "split")
+    second.run(progress=False)
+    assert (tmp_path / "whole" / "history.csv").read_bytes() == (tmp_path / "split" / "history.csv").read_bytes()
+    assert np.array_equal(second.particles.position, whole.particles.position)
+    assert np.array_equal(last_snapshot(tmp_path / "whole")["stress"], last_snapshot(tmp_path / "split")["stress"])
+    with pytest.raises(cairn.InputError, match="restart honours"):
+        cairn.Simulation.restart(checkpoint, set={"method.order": 2})

@@ -53,4 +53,9 @@ class Engine {
 /// A new run of a validated config (simulation.dimension picks the instantiation).
 std::unique_ptr<Engine> make_engine(const Config& config, const RunOptions& options);
 
+/// The run a checkpoint holds, continuing from it (as `cairn restart`: `overrides` only of
+/// restart_keys(), the output beside the checkpoint unless output.directory is given).
+std::unique_ptr<Engine> restore_engine(const std::filesystem::path& checkpoint,
+                                       const std::vector<std::string>& overrides, const RunOptions& options);
+
 }  // namespace cairn

@@ -674,6 +674,7 @@ template <int D>
 class RunnerEngine final : public Engine {
  public:
   RunnerEngine(const Config& config, const RunOptions& options) : runner_(config, options) {}
+  void restore(const CheckpointData<D>& data) { runner_.restore(data); }
   [[nodiscard]] std::string name() const override {
     return runner_.config().method.integration == "wls" ? "wls" : "mpm";
   }
@@ -733,11 +734,17 @@ RunSummary run(const Config& config, const RunOptions& options) {
 }
 
 namespace {
+/// A checkpoint's state and its stored input with the overrides, checked for a continuation.
 template <int D>
-RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
-                       const RunOptions& options) {
-  const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
-  const Config config = load_config_string(data.config_toml, file.string(), overrides);
+struct Restored {
+  CheckpointData<D> data;
+  Config config;
+};
+
+template <int D>
+Restored<D> restored(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
+  Config config = load_config_string(data.config_toml, file.string(), overrides);
   if (config.simulation.dimension != D)
     throw std::invalid_argument("--set cannot change simulation.dimension on restart");
   const double end = config.simulation.end_time;
@@ -752,7 +759,23 @@ RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std:
   // them (rank 0 alone on several ranks).
   if (Comm::world().is_root())
     for (const auto& w : config.warnings) std::fprintf(stderr, "cairn: warning: %s\n", w.c_str());
-  return run_dim<D>(config, options, &data);
+  return {std::move(data), std::move(config)};
+}
+
+template <int D>
+RunSummary restart_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                       const RunOptions& options) {
+  const Restored<D> r = restored<D>(file, overrides);
+  return run_dim<D>(r.config, options, &r.data);
+}
+
+template <int D>
+std::unique_ptr<Engine> restore_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                                    const RunOptions& options) {
+  const Restored<D> r = restored<D>(file, overrides);
+  auto engine = std::make_unique<RunnerEngine<D>>(r.config, options);
+  engine->restore(r.data);
+  return engine;
 }
 }  // namespace
 
@@ -767,8 +790,10 @@ const std::vector<std::string>& restart_keys() {
   return keys;
 }
 
-RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
-                   const RunOptions& options) {
+namespace {
+/// The overrides of a restart: only restart_keys(), plus the output folder beside the checkpoint.
+std::vector<std::string> restart_overrides(const std::filesystem::path& checkpoint,
+                                           const std::vector<std::string>& overrides) {
   // The checkpoint holds the particles (masses, positions, material state), the grid and the
   // counters the first input made; keys that made them would only half apply (the stored input
   // would say one thing, the state another), so only the keys that steer the continuation do.
@@ -800,6 +825,26 @@ RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<st
     for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
     all.push_back("output.directory=" + quoted + "\"");
   }
+  return all;
+}
+}  // namespace
+
+std::unique_ptr<Engine> restore_engine(const std::filesystem::path& checkpoint,
+                                       const std::vector<std::string>& overrides, const RunOptions& options) {
+  const std::vector<std::string> all = restart_overrides(checkpoint, overrides);
+  if (fem::is_checkpoint(checkpoint))
+    throw std::invalid_argument(checkpoint.string() + ": [fem] runs are not yet driven through the engine "
+                                "interface (cairn restart only)");
+  switch (checkpoint_dimension(checkpoint)) {
+    case 1: return restore_dim<1>(checkpoint, all, options);
+    case 2: return restore_dim<2>(checkpoint, all, options);
+    default: return restore_dim<3>(checkpoint, all, options);
+  }
+}
+
+RunSummary restart(const std::filesystem::path& checkpoint, const std::vector<std::string>& overrides,
+                   const RunOptions& options) {
+  const std::vector<std::string> all = restart_overrides(checkpoint, overrides);
   if (fem::is_checkpoint(checkpoint)) {
     if (Comm::world().parallel())
       throw std::invalid_argument(checkpoint.string() + ": [fem] runs on one MPI rank only (docs/parallel.md)");
