@@ -6,7 +6,7 @@
 #include <omp.h>
 
 #include "cairn/fem/solver.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 
 namespace cairn {
 namespace {

@@ -15,7 +15,7 @@
 
 #include "../tests/support/mesh_writer.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

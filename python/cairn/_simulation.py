@@ -54,6 +54,8 @@ class Particles:
         try:
             return self._engine.particle_array(name, False)
         except ValueError as error:
+            if "no particle array" not in str(error):
+                raise  # (an FEM run has no particles at all)
             raise AttributeError(str(error)) from None
 
     def __dir__(self):
@@ -86,7 +88,7 @@ class Particles:
 
 
 class Simulation:
-    """One run of Cairn's engine (MPM or WLS), set up from an input file or a dict.
+    """One run of one of Cairn's engines (MPM, WLS, FEM), set up from an input file or a dict.
 
     Make one with ``Simulation.from_toml(path, set={...})``, ``Simulation.from_dict({...})`` or
     ``Simulation.from_text(toml_text)``; each validates the input exactly as ``cairn run`` does
@@ -193,7 +195,7 @@ class Simulation:
 
     @property
     def engine(self):
-        """'mpm' or 'wls'."""
+        """The engine's name: 'mpm', 'wls' or 'fem'."""
         return self._engine.name
 
     @property
@@ -292,7 +294,8 @@ class Simulation:
         self.close()
 
     def __repr__(self):
-        return (f"<cairn.Simulation {self.engine} {self.dimension}D, {len(self.particles)} particles, "
+        items = "elements" if self.engine == "fem" else "particles"
+        return (f"<cairn.Simulation {self.engine} {self.dimension}D, {self._engine.items} {items}, "
                 f"step {self.steps}, t = {self.time:.6g} of {self.end_time:.6g}>")
 
 

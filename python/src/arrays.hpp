@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "cairn/sim/engine.hpp"
+#include "cairn/run/engine.hpp"
 
 namespace cairn::python {
 

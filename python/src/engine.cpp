@@ -1,4 +1,4 @@
-// Run control for Python: an Engine (sim/engine.hpp, the code `cairn run` runs) stepped with
+// Run control for Python: an Engine (run/engine.hpp, the code `cairn run` runs) stepped with
 // the GIL released, Ctrl-C turned into KeyboardInterrupt between steps, checkpoints on demand.
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
@@ -10,7 +10,7 @@
 
 #include "arrays.hpp"
 #include "bindings.hpp"
-#include "cairn/sim/engine.hpp"
+#include "cairn/run/engine.hpp"
 
 namespace cairn::python {
 namespace {
@@ -85,7 +85,7 @@ class PyEngine {
 
 void bind_engine(py::module_& m) {
   py::register_exception<RunFailure>(m, "RunFailure", PyExc_RuntimeError);
-  py::class_<PyEngine>(m, "Engine", "One run of one engine (sim/engine.hpp); use cairn.Simulation.")
+  py::class_<PyEngine>(m, "Engine", "One run of one engine (run/engine.hpp); use cairn.Simulation.")
       .def(py::init<const Config&>(), py::arg("config"))
       .def_static(
           "restore",

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
-#include "cairn/io/schema.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
+#include "cairn/input/schema.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/util/registry.hpp"
 

@@ -9,8 +9,8 @@
 
 #include "cairn/bc/time_function.hpp"
 #include "cairn/bc/traction.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

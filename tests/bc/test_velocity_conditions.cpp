@@ -13,9 +13,9 @@
 #include <sstream>
 
 #include "cairn/io/checkpoint.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
-#include "cairn/sim/run.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
+#include "cairn/run/engine.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
 

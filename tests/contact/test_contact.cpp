@@ -20,8 +20,18 @@ ContactInput approaching(double tangential) {
   return in;
 }
 
+/// A law's configuration as [contact] would give it: law name, friction, dynamic_friction, slide.
+ContactLawConfig law_config(const std::string& name, double friction, double dynamic, const std::string& slide) {
+  ContactLawConfig c;
+  c.law = name;
+  c.plugin.set("friction", friction);
+  c.plugin.set("dynamic_friction", dynamic);
+  c.plugin.set("slide", slide);
+  return c;
+}
+
 TEST(ContactLaws, FrictionlessKeepsOnlyTheNormalChange) {
-  auto law = make_contact_law(ContactLawConfig{"frictionless", 0.0, -1.0, "0"}, {});
+  auto law = make_contact_law(law_config("frictionless", 0.0, -1.0, "0"), {});
   const Vec3 dp = law->momentum_change(approaching(1.5));
   EXPECT_DOUBLE_EQ(dp[0], 0.0);
   EXPECT_DOUBLE_EQ(dp[1], -2.0);
@@ -30,7 +40,7 @@ TEST(ContactLaws, FrictionlessKeepsOnlyTheNormalChange) {
 
 TEST(ContactLaws, CoulombSticksBelowMuNAndSlidesAtMuDynamicNAbove) {
   // N_c A dt = -dp0.n = 2; stick needs |dp0_t| <= mu_s * 2.
-  auto law = make_contact_law(ContactLawConfig{"coulomb", 0.5, 0.25, "0"}, {});
+  auto law = make_contact_law(law_config("coulomb", 0.5, 0.25, "0"), {});
   const Vec3 stick = law->momentum_change(approaching(0.9));
   EXPECT_DOUBLE_EQ(stick[0], 0.9);
   const Vec3 slide = law->momentum_change(approaching(1.5));
@@ -41,27 +51,27 @@ TEST(ContactLaws, CoulombSticksBelowMuNAndSlidesAtMuDynamicNAbove) {
 }
 
 TEST(ContactLaws, GeneralLawWithMuNcMatchesCoulombAndIsCappedAtStick) {
-  auto general = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "0.25*Nc"}, {});
-  auto coulomb = make_contact_law(ContactLawConfig{"coulomb", 0.25, -1.0, "0"}, {});
+  auto general = make_contact_law(law_config("general", 0.0, -1.0, "0.25*Nc"), {});
+  auto coulomb = make_contact_law(law_config("coulomb", 0.25, -1.0, "0"), {});
   for (double t : {0.1, 0.4, 1.5, -3.0}) {
     const Vec3 a = general->momentum_change(approaching(t)), b = coulomb->momentum_change(approaching(t));
     EXPECT_NEAR((a - b).norm(), 0.0, 1e-13) << t;
   }
   // A slide expression using the slip speed: 10 * vslip with vslip = |dp0_t| / m_red.
   // vslip = 0.01 / 0.5 = 0.02: S = 0.2, S A dt = 2e-4 < 0.01 slides; 1e4 vslip would stick.
-  auto viscous = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "10*vslip"}, {});
+  auto viscous = make_contact_law(law_config("general", 0.0, -1.0, "10*vslip"), {});
   const ContactInput in = approaching(0.01);
   EXPECT_NEAR(viscous->momentum_change(in)[0], 2e-4, 1e-15);
-  auto stiff = make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "1e4*vslip"}, {});
+  auto stiff = make_contact_law(law_config("general", 0.0, -1.0, "1e4*vslip"), {});
   EXPECT_NEAR(stiff->momentum_change(in)[0], 0.01, 1e-15);
-  EXPECT_THROW(make_contact_law(ContactLawConfig{"general", 0.0, -1.0, "2*bogus"}, {}), std::invalid_argument);
+  EXPECT_THROW(make_contact_law(law_config("general", 0.0, -1.0, "2*bogus"), {}), std::invalid_argument);
 }
 
 TEST(ContactLaws, PerfectIsBondedAndUnknownNamesAreListed) {
-  auto perfect = make_contact_law(ContactLawConfig{"perfect", 0.0, -1.0, "0"}, {});
+  auto perfect = make_contact_law(law_config("perfect", 0.0, -1.0, "0"), {});
   EXPECT_TRUE(perfect->bonded());
   try {
-    (void)make_contact_law(ContactLawConfig{"glue", 0.0, -1.0, "0"}, {});
+    (void)make_contact_law(law_config("glue", 0.0, -1.0, "0"), {});
     FAIL() << "no error";
   } catch (const UnknownName& e) {
     EXPECT_NE(std::string(e.what()).find("coulomb"), std::string::npos);

@@ -25,7 +25,7 @@ Config approaching_blocks(const std::string& first_correction) {
   c.bodies.push_back(right);
   c.contact.mode = "body";
   c.contact.law.law = "coulomb";
-  c.contact.law.friction = 0.4;
+  c.contact.law.plugin.set("friction", 0.4);
   c.contact.first_correction = first_correction;
   return c;
 }

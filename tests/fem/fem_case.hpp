@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 
 namespace cairn::test {
 

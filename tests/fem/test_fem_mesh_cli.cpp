@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "cairn/fem/mesh.hpp"
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 #include "fem_case.hpp"
 
 namespace cairn {

@@ -14,7 +14,7 @@
 #include <numbers>
 
 #include "cairn/fem/solver.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "fem_case.hpp"
 
 namespace cairn {

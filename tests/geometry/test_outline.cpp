@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "../support/scratch_test.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

@@ -7,9 +7,9 @@
 #include <fstream>
 
 #include "../support/scratch_test.hpp"
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 #include "cairn/io/hdf5_util.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

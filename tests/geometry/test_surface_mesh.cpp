@@ -13,8 +13,8 @@
 #include "../support/mesh_writer.hpp"
 #include "../support/scratch_test.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "../support/scratch_test.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

@@ -22,7 +22,7 @@
 #include "cairn/io/hdf5_util.hpp"
 #include "cairn/io/history.hpp"
 #include "cairn/io/snapshot.hpp"
-#include "cairn/io/units.hpp"
+#include "cairn/config/units.hpp"
 #include "cairn/util/sha256.hpp"
 
 namespace fs = std::filesystem;

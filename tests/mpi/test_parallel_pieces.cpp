@@ -8,7 +8,7 @@
 #include <random>
 
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 #include "cairn/parallel/decomposition.hpp"
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/parallel/particle_transfer.hpp"

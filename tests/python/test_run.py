@@ -180,3 +180,15 @@ def test_restart_from_python_ends_bit_identical(two_blocks, tmp_path):
     assert np.array_equal(last_snapshot(tmp_path / "whole")["stress"], last_snapshot(tmp_path / "split")["stress"])
     with pytest.raises(cairn.InputError, match="restart honours"):
         cairn.Simulation.restart(checkpoint, set={"method.order": 2})
+
+
+def test_fem_runs_from_python(tmp_path):
+    """The reference FEM (seed 001 Appendix A) is one more engine: the same run control."""
+    from conftest import SOURCE
+    sim = cairn.Simulation.from_toml(SOURCE / "tests" / "fem" / "ring_mms.toml",
+                                     set={"simulation.max_steps": 5}, output=tmp_path)
+    assert sim.engine == "fem" and "elements" in repr(sim)
+    sim.run(progress=False)
+    assert sim.steps == 5 and sim.history(as_pandas=False)["step"][-1] == 5
+    with pytest.raises(ValueError, match="MPM and WLS"):
+        sim.particles.position

@@ -32,9 +32,9 @@
 #include <unistd.h>
 #include <vector>
 
-#include "cairn/io/errors.hpp"
-#include "cairn/io/input.hpp"
-#include "cairn/io/schema.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/input/input.hpp"
+#include "cairn/input/schema.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/registry.hpp"
 

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "../support/config_builder.hpp"
-#include "cairn/sim/names.hpp"
+#include "cairn/input/names.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/transfer/transfer.hpp"
 
@@ -126,8 +126,8 @@ HandExpected run_hand_case(const HandCase& hc, const std::string& update, int k,
   cfg.bodies[0].particles_per_cell = {3};
   cfg.method.update = update;
   cfg.method.order = k;
-  cfg.method.beta = beta;
-  cfg.method.blend_position = blend_position;
+  cfg.method.plugin.set("beta", beta);
+  cfg.method.plugin.set("blend_position", blend_position);
   Simulation<1> sim(cfg);
   auto& P = sim.particles();
   EXPECT_EQ(P.n(), hc.x.size());
@@ -335,7 +335,7 @@ TEST(Schemes, DissipatedEnergyAgreesWithTheParticleEnergyBalance) {
 TEST(Schemes, BlendWithBetaOneIsFlip) {
   // seed 002 Eq. 1.79: beta = 1 leaves only the FLIP part, for any projector order.
   Config a = moving_block("flip"), b = moving_block("blend", 3);
-  b.method.beta = 1.0;
+  b.method.plugin.set("beta", 1.0);
   Simulation<2> sa(a), sb(b);
   for (int s = 0; s < 5; ++s) {
     sa.step(1e-4);

@@ -16,7 +16,7 @@
 #include "../support/config_builder.hpp"
 #include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
-#include "cairn/sim/names.hpp"
+#include "cairn/input/names.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -26,7 +26,7 @@ namespace {
 template <int D>
 std::unique_ptr<ShapeFamily<D>> family(const std::string& name, double smoothing_length = 0.0) {
   Config cfg = test::box_config(D, name);
-  cfg.method.smoothing_length = smoothing_length;
+  cfg.method.plugin.set("smoothing_length", smoothing_length);
   return make_shape_family<D>(ShapeContext{cfg.method, D});
 }
 

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "../support/config_builder.hpp"
-#include "cairn/sim/names.hpp"
+#include "cairn/input/names.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/parallel.hpp"

@@ -6,7 +6,7 @@
 
 #include "../support/config_builder.hpp"
 #include "../support/png_writer.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

@@ -18,9 +18,9 @@
 #include "../support/fresh_dir.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/io/hdf5_util.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/parallel/particle_transfer.hpp"
-#include "cairn/sim/run.hpp"
+#include "cairn/run/engine.hpp"
 #include "cairn/sim/simulation.hpp"
 #include "cairn/util/failure.hpp"
 

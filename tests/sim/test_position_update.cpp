@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

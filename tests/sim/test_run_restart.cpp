@@ -12,8 +12,8 @@
 
 #include "../support/fresh_dir.hpp"
 #include "cairn/io/checkpoint.hpp"
-#include "cairn/io/input.hpp"
-#include "cairn/sim/run.hpp"
+#include "cairn/input/input.hpp"
+#include "cairn/run/engine.hpp"
 
 namespace cairn {
 namespace {

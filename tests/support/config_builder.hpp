@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 
 namespace cairn::test {
 

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 
 namespace cairn::test {
 

@@ -407,7 +407,7 @@ Config wls_config(int D, const std::string& kind, double h, int ppc = 2) {
 TEST(WlsSignedDistance, CircleNodesGetTheirDistanceToTheSurface) {
   for (const bool projected : {true, false}) {
     Config c = wls_config(2, "circle", 0.05);
-    c.method.surface_distance = projected ? "projection" : "distance";
+    c.method.plugin.set("surface_distance", std::string(projected ? "projection" : "distance"));
     Simulation<2> sim(c);
     const auto& d = sim.wls()->signed_distance();
     const auto& grid = sim.grid();
@@ -501,7 +501,7 @@ void check_particle_gradient(const std::string& velocity_gradient) {
   // One step from an unstressed body moving with v = v0 + A x: the forces vanish, v+ is the
   // node fit, and particles away from the surface get grad V = A exactly, by either rule.
   Config c = wls_config(D, "circle", 0.05);
-  c.method.velocity_gradient = velocity_gradient;
+  c.method.plugin.set("velocity_gradient", std::string(velocity_gradient));
   const double entries[9] = {0.3, -0.7, 0.2, 0.5, 0.1, -0.4, 0.6, -0.2, 0.9};
   Eigen::Matrix<double, D, D> A;
   for (int a = 0; a < D; ++a) {

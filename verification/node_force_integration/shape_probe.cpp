@@ -37,8 +37,8 @@ template <int D>
 int run(const Options& o) {
   Config cfg;
   cfg.method.shape = o.family;
-  cfg.method.smoothing_length = o.smoothing;
-  cfg.method.cpdi_max_span = o.max_span;
+  cfg.method.plugin.set("smoothing_length", o.smoothing);
+  cfg.method.plugin.set("cpdi_max_span", o.max_span);
   auto fam = make_shape_family<D>(ShapeContext{cfg.method, D});
   Vec<D> origin, h;
   IVec<D> n;

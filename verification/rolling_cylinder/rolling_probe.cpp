@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cairn/contact/contact.hpp"
-#include "cairn/io/input.hpp"
+#include "cairn/input/input.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/shapes/shape_family.hpp"
 
 namespace cairn {

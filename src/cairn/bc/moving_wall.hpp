@@ -25,7 +25,7 @@
 #include "cairn/bc/prescribed_velocity.hpp"
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/parallel/comm.hpp"
 
 namespace cairn {

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "cairn/bc/expression.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 
 namespace cairn {
 

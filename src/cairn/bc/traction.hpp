@@ -44,7 +44,7 @@
 
 #include "cairn/bc/time_function.hpp"
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/parallel/comm.hpp"
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 
 namespace cairn {
 

@@ -19,7 +19,7 @@
 
 #include "cairn/contact/law.hpp"
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/parallel/exact_sum.hpp"
 #include "cairn/particles/particles.hpp"

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cairn/bc/expression.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/math/types.hpp"
 #include "cairn/util/registry.hpp"
 

@@ -9,7 +9,7 @@
 
 #include "cairn/fem/gmsh_module.hpp"
 #include "cairn/fem/mesh.hpp"
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 
 namespace cairn::fem {
 namespace {

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 
 namespace cairn::fem {
 

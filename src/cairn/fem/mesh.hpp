@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/math/types.hpp"
 
 namespace cairn::fem {

@@ -166,6 +166,7 @@ void write_checkpoint(const fs::path& path, const Checkpoint& d) {
     h5::Handle file = h5::create_file(tmp);
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", checkpoint_format);
+    h5::write_string_attribute(root, "engine", "fem");  // (run/engine.hpp: the engine a checkpoint names)
     h5::write_int64_attribute(root, "version", 1);
     h5::write_text(root, "input", d.config_toml);
     const auto& s = d.state;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 #include "cairn/materials/plane_stress.hpp"
 #include "cairn/util/failure.hpp"
 

@@ -11,7 +11,7 @@
 #include "cairn/bc/expression.hpp"
 #include "cairn/bc/time_function.hpp"
 #include "cairn/fem/mesh.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/materials/material.hpp"
 
 namespace cairn::fem {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "cairn/io/keys.hpp"
+#include "cairn/config/keys.hpp"
 
 namespace cairn::geometry {
 

@@ -7,7 +7,7 @@
 
 #include "cairn/io/atomic_file.hpp"
 #include "cairn/io/checksum.hpp"
-#include "cairn/io/errors.hpp"
+#include "cairn/config/errors.hpp"
 #include "cairn/io/hdf5_util.hpp"
 
 namespace cairn {
@@ -151,6 +151,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     const hid_t root = file.get();
     h5::write_string_attribute(root, "format", format_name);
     h5::write_int64_attribute(root, "version", checkpoint_format_version);
+    h5::write_string_attribute(root, "engine", data.engine);
     h5::write_int64_attribute(root, "dimension", D);
     h5::write_double_attribute(root, "time", data.time);
     h5::write_int64_attribute(root, "step", data.step);
@@ -244,6 +245,7 @@ CheckpointData<D> read_checkpoint(const fs::path& path, const Comm& comm) {
                                  computed));
   }
   CheckpointData<D> data;
+  data.engine = h5::has_attribute(root, "engine") ? h5::read_string_attribute(root, "engine") : "mpm";
   data.time = h5::read_double_attribute(root, "time");
   data.step = h5::read_int64_attribute(root, "step");
   data.previous_dt = h5::read_double_attribute(root, "previous_dt");
@@ -326,6 +328,28 @@ int checkpoint_dimension(const fs::path& path) {
   int dimension = 0;
   h5::Handle file = open_checkpoint(path, dimension);
   return dimension;
+}
+
+std::string checkpoint_engine(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw std::runtime_error("checkpoint file '" + path.string() + "' does not exist");
+  h5::Handle file;
+  try {
+    h5::silence_errors();
+    file = h5::open_file(path);
+  } catch (const std::runtime_error&) {
+    throw std::runtime_error("'" + path.string() + "' is not a Cairn checkpoint (not an HDF5 file)");
+  }
+  const hid_t root = file.get();
+  try {
+    if (h5::has_attribute(root, "engine")) return h5::read_string_attribute(root, "engine");
+    // Before engines had names: the FEM wrote its own format (fem/output.hpp).
+    if (h5::has_attribute(root, "format") && h5::read_string_attribute(root, "format") == "cairn-fem-checkpoint")
+      return "fem";
+  } catch (const std::runtime_error&) {
+    // an attribute of another type: read_checkpoint of the mpm engine names the problem
+  }
+  return "mpm";
 }
 
 template void write_checkpoint<1>(const fs::path&, const CheckpointData<1>&);

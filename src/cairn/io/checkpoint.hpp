@@ -5,7 +5,8 @@
 // gives results identical to a run that was never interrupted. Files are written atomically.
 //
 // File layout (format "cairn-checkpoint", version 2; version 1 files are still read):
-//   root attributes: format, version, dimension, time, step, previous_dt, snapshot_next_index,
+//   root attributes: format, version, engine (the engine that wrote it: mpm or wls; absent
+//     before the engines had names, read as mpm), dimension, time, step, previous_dt, snapshot_next_index,
 //     checksum (io/checksum.hpp: over everything else; a mismatch is refused on reading),
 //     and the metadata of snapshots (cairn_version, title, units, unit_*, input_sha256 of
 //     /config_toml); /material_names, /body_names (string lists)
@@ -36,6 +37,7 @@ namespace cairn {
 /// Everything a run needs to continue exactly where it stopped.
 template <int D>
 struct CheckpointData {
+  std::string engine = "mpm";  ///< the engine that wrote it (run/engine.hpp)
   std::string config_toml;  ///< the resolved input, as TOML text
   double time = 0;
   long long step = 0;
@@ -80,6 +82,10 @@ template <int D>
 CheckpointData<D> read_checkpoint(const std::filesystem::path& path, const Comm& comm);
 /// The simulation dimension stored in a checkpoint (checks format and version the same way).
 int checkpoint_dimension(const std::filesystem::path& path);
+/// The engine that wrote a Cairn checkpoint of any engine (its `engine` attribute; files written
+/// before engines had names: "fem" for the FEM's format, else "mpm"). Throws std::runtime_error,
+/// as read_checkpoint does, for a file that is missing or no Cairn checkpoint.
+std::string checkpoint_engine(const std::filesystem::path& path);
 
 extern template void write_checkpoint<1>(const std::filesystem::path&, const CheckpointData<1>&);
 extern template void write_checkpoint<2>(const std::filesystem::path&, const CheckpointData<2>&);

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "cairn/io/config.hpp"
-#include "cairn/io/units.hpp"
+#include "cairn/config/config.hpp"
+#include "cairn/config/units.hpp"
 
 namespace cairn {
 

@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 
 namespace cairn {
 

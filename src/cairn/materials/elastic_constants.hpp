@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "cairn/io/config.hpp"
-#include "cairn/io/keys.hpp"
+#include "cairn/config/config.hpp"
+#include "cairn/config/keys.hpp"
 
 namespace cairn {
 

@@ -1,7 +1,6 @@
 #include "cairn/materials/material.hpp"
 
 #include "cairn/materials/elastic_constants.hpp"
-#include "cairn/sim/names.hpp"
 
 namespace cairn {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "cairn/io/config.hpp"
-#include "cairn/io/keys.hpp"
-#include "cairn/io/units.hpp"
+#include "cairn/config/config.hpp"
+#include "cairn/config/keys.hpp"
+#include "cairn/config/units.hpp"
 #include "cairn/math/sym_mat3.hpp"
 #include "cairn/math/types.hpp"
 #include "cairn/util/registry.hpp"
@@ -120,6 +120,8 @@ std::map<std::string, MaterialModelInfo>& material_model_info();
 
 /// Create a material from a validated config (throws UnknownName for an unknown model).
 std::unique_ptr<Material> make_material(const MaterialConfig& cfg);
+/// The registered model names (the allowed values of [[material]].model).
+std::vector<std::string> material_model_names();
 
 /// Registration helper: `CAIRN_REGISTER_MATERIAL(NeoHookean, "neo_hookean", info)`.
 struct MaterialRegistration {

@@ -4,6 +4,7 @@
 //     V^(n+1) = beta V + (1 - beta) P V + S a dt
 //     VV = S v                              (blend_position = "grid")
 //     VV = beta S v + (1 - beta) P V        (blend_position = "projected")
+#include "cairn/config/plugin_keys.hpp"
 #include "cairn/schemes/scheme.hpp"
 
 namespace cairn {
@@ -12,7 +13,7 @@ namespace {
 template <int D>
 class Blend final : public UpdateScheme<D> {
  public:
-  explicit Blend(const MethodConfig& m) : beta_(m.beta), projected_(m.blend_position == "projected") {}
+  explicit Blend(const MethodConfig& m) : beta_(m.plugin.real("beta")), projected_(m.plugin.text("blend_position") == "projected") {}
   FullMass full_mass() const override { return FullMass::of_initial; }
   Effective<D> effective(const GridAtParticle<D>& g) const override {
     const Vec<D>& PV = g.Sv_full;
@@ -27,5 +28,16 @@ class Blend final : public UpdateScheme<D> {
 };
 
 }  // namespace
+CAIRN_DECLARE_KEYS(blend, {"blend", {"method"}, {
+    Key("", "beta", KeyType::real,
+      "FLIP fraction beta of the `blend` update (seed 002 Eq. 1.79).")
+      .by_default("0.99")
+      .min(0.0)
+      .max(1.0),
+    Key("", "blend_position", KeyType::string,
+      "Effective velocity of the `blend` update: grid = S v, projected = "
+      "beta S v + (1 - beta) P V (seed 002 Eq. 1.80).")
+      .by_default("\"grid\"")
+      .choices([] { return std::vector<std::string>{"grid", "projected"}; })}, {}, "cpdi_max_span"});
 CAIRN_REGISTER_SCHEME(Blend, "blend", "beta FLIP + (1 - beta) XPIC(k)-projected update (seed 002 Eq. 1.79-1.80)");
 }  // namespace cairn

@@ -12,7 +12,7 @@
 
 #include <memory>
 
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/math/types.hpp"
 #include "cairn/util/registry.hpp"
 

@@ -7,7 +7,7 @@ namespace {
 template <int D>
 class B2Cpdi final : public ShapeFamily<D> {
  public:
-  explicit B2Cpdi(const ShapeContext& ctx) : max_span_(ctx.method.cpdi_max_span) {}
+  explicit B2Cpdi(const ShapeContext& ctx) : max_span_(ctx.method.plugin.real("cpdi_max_span")) {}
   int ghost_layers() const override { return 3; }
   ParticleDomain particle_domain() const override { return ParticleDomain::convected; }
   void build(const Grid<D>& g, const Particles<D>& p, TransferCache<D>& c) const override {

@@ -29,8 +29,7 @@
 
 #include "cairn/shapes/grid_functions.hpp"
 #include "cairn/shapes/shape_family.hpp"
-#include "cairn/util/failure.hpp"
-#include "cairn/util/parallel.hpp"
+#include "cairn/shapes/stencil_build.hpp"
 
 namespace cairn {
 
@@ -230,8 +229,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     slots = cache.stride;
     widest = cache.stride;
   }
-  std::int64_t first_bad = INT64_MAX;
-  IVec<D> lo = IVec<D>::Zero(), hi = IVec<D>::Zero();
+  StencilReach<D> reach;
   for (int attempt = 0; attempt < 2; ++attempt) {
   if (sized) {
     // Sizing pass: the largest node box of this step, at least the fixed box.
@@ -246,14 +244,11 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     cache.reserve(particles.n(), slots);
   }
   bool overflow = false;
-  first_bad = INT64_MAX;
-  lo.setZero();
-  hi.setZero();
+  reach = StencilReach<D>();
   StealingShare share(n);
 #pragma omp parallel
   {
-    IVec<D> lo_t = IVec<D>::Zero(), hi_t = IVec<D>::Zero();
-    std::int64_t bad_t = INT64_MAX;
+    StencilReach<D> local;
     bool overflow_t = false;
     std::vector<std::int32_t> offset(static_cast<std::size_t>(D) * widest);
     std::array<std::vector<double>, D> w1, dw1;  // fallback weights per axis
@@ -268,7 +263,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
     for (std::int64_t first_p, last_p; cursor.next(first_p, last_p);)
     for (std::int64_t p = first_p; p < last_p; ++p) {
       if (!Grid<D>::indexable(grid.to_cell_units(particles.position[p]))) {  // far outside or NaN
-        bad_t = std::min<std::int64_t>(bad_t, p);
+        local.bad(p);
         cache.count[p] = 0;
         continue;
       }
@@ -348,8 +343,8 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
       // odometer (used <= idx, so the general box compacts in place). The box bounds give the
       // colouring reach.
       for (int a = 0; a < D; ++a) {
-        lo_t[a] = std::max(lo_t[a], cell[a] - dom.lo[a]);
-        hi_t[a] = std::max(hi_t[a], dom.lo[a] + dom.dims[a] - 1 - cell[a] - 1);
+        local.lo[a] = std::max(local.lo[a], cell[a] - dom.lo[a]);
+        local.hi[a] = std::max(local.hi[a], dom.lo[a] + dom.dims[a] - 1 - cell[a] - 1);
       }
       int used = 0;
       if (fixed) {
@@ -358,7 +353,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
           for (int k = 0; k < Fixed::width; ++k) off[a][k] = grid.axis_index(a, dom.lo[a] + k);
         bool outside = false;
         used = cpdi_detail::compact_fixed<D, Fn>(fixed_box, off, &cache.node[out], S, G, outside);
-        if (outside) bad_t = std::min<std::int64_t>(bad_t, p);
+        if (outside) local.bad(p);
       } else {
         for (int a = 0; a < D; ++a)
           for (int k = 0; k < dims[a]; ++k) offset[a * widest + k] = grid.axis_index(a, dom.lo[a] + k);
@@ -378,7 +373,7 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
             if (S[idx] == 0.0 && G[idx].isZero(0.0)) continue;
             const std::int32_t off = offset[i];
             if (row_outside || off < 0) {
-              bad_t = std::min<std::int64_t>(bad_t, p);
+              local.bad(p);
               continue;
             }
             cache.node[out + used] = row_node + off;
@@ -397,24 +392,13 @@ void build_cpdi(double max_span, const Grid<D>& grid, const Particles<D>& partic
 #pragma omp critical
     {
       overflow = overflow || overflow_t;
-      first_bad = std::min(first_bad, bad_t);
-      lo = lo.cwiseMax(lo_t);
-      hi = hi.cwiseMax(hi_t);
+      reach.merge(local);
     }
   }
   if (!overflow) break;
   sized = true;
   }
-  cache.reach_lo = lo;
-  cache.reach_hi = hi;
-  if (first_bad != INT64_MAX) {
-    const Vec<D>& x = particles.position[first_bad];
-    std::string where;
-    for (int a = 0; a < D; ++a) where += (a ? ", " : "") + failure_number(x[a]);
-    throw SimulationFailure(first_bad, "position",
-                            "particle " + std::to_string(first_bad) + " left the grid at (" +
-                                where + "): its CPDI domain reaches beyond the ghost nodes");
-  }
+  finish_stencils(reach, particles, cache, "its CPDI domain");
 }
 
 }  // namespace cairn

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 #include "cairn/util/registry.hpp"

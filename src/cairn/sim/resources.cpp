@@ -14,8 +14,8 @@
 #include "cairn/geometry/outline.hpp"
 #include "cairn/geometry/point_set.hpp"
 #include "cairn/geometry/surface_mesh.hpp"
-#include "cairn/io/errors.hpp"
-#include "cairn/io/image.hpp"
+#include "cairn/config/errors.hpp"
+#include "cairn/geometry/image.hpp"
 #include "cairn/sim/simulation.hpp"
 
 namespace cairn {

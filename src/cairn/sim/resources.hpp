@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/particles/particles.hpp"
 
 namespace cairn {

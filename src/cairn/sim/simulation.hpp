@@ -16,7 +16,7 @@
 #include "cairn/bc/velocity_conditions.hpp"
 #include "cairn/contact/contact.hpp"
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/parallel/comm.hpp"
 #include "cairn/parallel/distribution.hpp"
@@ -34,6 +34,7 @@ namespace wls {
 template <int D>
 class Integrator;
 }
+struct StressTiming;
 
 /// Global sums reported in history.csv.
 struct Totals {
@@ -55,6 +56,8 @@ class Simulation {
   /// constructor and step() are then collective.
   explicit Simulation(const Config& config, const Comm& comm = Comm::serial());
   ~Simulation();
+  Simulation(const Simulation&) = delete;  // (its step hooks hold `this`)
+  Simulation& operator=(const Simulation&) = delete;
 
   // ---- one explicit step (seed 000 Table 1) -------------------------------------------------
   /// dt from the CFL rule (seed 001 Eq. 34) or the fixed step, not beyond end_time.
@@ -89,9 +92,7 @@ class Simulation {
   template <class Finish>
   void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish,
                          SlotRange slots);
-  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out) {
-    lumped_projection(in, out, [](std::int32_t, const Vec<D>&) {}, {0, n_slots()});
-  }
+  void lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
   void lumped_projection_distributed(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out);
 
   /// Seconds spent per pipeline stage so far (name, seconds), in pipeline order.
@@ -190,6 +191,16 @@ class Simulation {
   /// A distributed step's start: imbalance, repartition, migration; then ghosts, window and
   /// stencils until the stencils fit the window.
   void distribute_and_build();
+  /// Named points of the step where optional features attach (their set-up calls on()): after
+  /// the full-mass expansion (multimaterial XPIC/FMPM's contact term), at the end (conduction).
+  enum class StepPoint { after_full_mass, end_of_step };
+  void on(StepPoint point, std::function<void(double dt)> hook) { hooks_[static_cast<int>(point)].push_back(std::move(hook)); }
+  void run_hooks(StepPoint point, double dt) {
+    for (const auto& hook : hooks_[static_cast<int>(point)]) hook(dt);
+  }
+  /// The node fields velocity conditions select their nodes by: the totals over the material
+  /// fields in multimaterial mode, the one field otherwise.
+  [[nodiscard]] const NodeField<D>& condition_fields() const { return contact_ ? totals_ : nodes_; }
   /// The stages of step() after its set-up (ghosts are dropped by step() however they end).
   template <class Lap>
   void step_stages(double dt, FullMass need, bool fmpm_velocities, int k, Lap& lap);
@@ -218,9 +229,11 @@ class Simulation {
   /// with conditions, or m~_k^-1 q for FMPM.
   void stress_velocity_from_momentum(const std::vector<Vec<D>>& momentum, bool full_mass);
   void reextrapolate_momentum();  ///< USL+/USAVG+: q = S^T M V^(n+1) into grid_term_
-  /// One step of the WLS method (seed 001 Sec. 4): its collection replaces the particle
-  /// transfers; the grid update, conditions and material updates are the engine's.
+  /// One step of the WLS method (seed 001 Sec. 4, wls/step.hpp): its collection replaces the
+  /// particle transfers; the grid update, conditions and material updates are the engine's,
+  /// which WlsStages hands it.
   void wls_step(double dt);
+  class WlsStages;
   /// F <- dF F and the material stress of particle p; the failing quantity's name, or null.
   const char* update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt);
   /// Throw SimulationFailure for particle p and the quantity update_particle named.
@@ -259,7 +272,9 @@ class Simulation {
   std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
   std::vector<char> material_in_use_;     ///< whether any particle has material m
   std::vector<char> wave_speed_varies_;   ///< Material::wave_speed_varies of material m
-  enum class Timing { usl, usf, usavg, usl_plus, usavg_plus } timing_ = Timing::usl;
+  const StressTiming* timing_ = nullptr;  ///< method.stress_update (sim/stress_timing.hpp)
+  /// The features attached to the step's named points (StepPoint), in attachment order.
+  std::array<std::vector<std::function<void(double dt)>>, 2> hooks_;
   bool use_full_mass_ = false;             ///< this step computes nodes_.velocity_full
   std::vector<Vec<D>> grid_term_, grid_proj_;  ///< scratch of the full-mass expansion
   std::vector<Vec<D>> particle_vec_;       ///< scratch: grid values at particles (FMPM/XPIC)

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
 

@@ -14,7 +14,7 @@
 #include <functional>
 #include <vector>
 
-#include "cairn/io/config.hpp"
+#include "cairn/config/config.hpp"
 #include "cairn/math/types.hpp"
 
 namespace cairn::wls {

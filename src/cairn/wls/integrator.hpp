@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "cairn/config/config.hpp"
 #include "cairn/grid/grid.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/transfer/cache.hpp"
@@ -54,7 +55,13 @@ struct Options {
   /// Eq. 29 as printed (sum_i v+_i (x) G_ip), unstable at free surfaces in our runs.
   bool quadrature_gradient = true;
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
+  /// method.filter_acceleration: the step filters the grid velocity increments (docs/wls.md).
+  bool filter_acceleration = false;
 };
+
+/// The Options the [method] keys of the WLS method give (wls/options.cpp, where they are
+/// declared); mirror planes and thickness are the engine's to set.
+Options options(const MethodConfig& method);
 
 /// One integration region: the inside part of a cut or full cell (Sec. 3.4) and its values.
 template <int D>
@@ -71,6 +78,7 @@ template <int D>
 class Integrator {
  public:
   Integrator(const Grid<D>& grid, const Options& options);
+  [[nodiscard]] const Options& options() const { return options_; }
 
   /// W, S and G of every particle over the 3^D nodes around its nearest node, and the
   /// colouring of the scatter. Throws SimulationFailure when a particle left the grid.

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "cairn/config/plugin_keys.hpp"
 #include "cairn/contact/law.hpp"
 
 namespace cairn {
@@ -17,6 +18,7 @@ namespace {
 class GeneralContact final : public ContactLaw {
  public:
   GeneralContact(const ContactLawConfig& c, const Constants& constants) {
+    const std::string slide = c.plugin.text("slide");
     const int n = std::max(1, omp_get_max_threads());
     for (int k = 0; k < n; ++k) {
       auto e = std::make_unique<Evaluator>();
@@ -26,10 +28,10 @@ class GeneralContact final : public ContactLaw {
         e->parser.DefineVar("t", &e->t);
         e->parser.DefineConst("pi", 3.141592653589793238462643383279502884);
         for (const auto& [name, value] : constants) e->parser.DefineConst(name, value);
-        e->parser.SetExpr(c.slide);
+        e->parser.SetExpr(slide);
         e->parser.Eval();
       } catch (const mu::Parser::exception_type& err) {
-        throw std::invalid_argument("contact law general: slide expression \"" + c.slide + "\": " + err.GetMsg() +
+        throw std::invalid_argument("contact law general: slide expression \"" + slide + "\": " + err.GetMsg() +
                                     " (variables: Nc, vslip, t)");
       }
       evaluators_.push_back(std::move(e));
@@ -53,6 +55,16 @@ class GeneralContact final : public ContactLaw {
   std::vector<std::unique_ptr<Evaluator>> evaluators_;
 };
 
+}  // namespace
+
+CAIRN_DECLARE_KEYS(general, {"general", {"contact", "contact_pair"}, {
+    Key("", "slide", KeyType::expression,
+      "general: sliding traction S_slide as an expression in Nc (normal traction), "
+      "vslip (tangential slip speed), t and [constants]; capped at the stick value.")
+      .by_default("\"0\"")
+      .variables({"Nc", "vslip", "t"})}, {}, "dynamic_friction"});
+
+namespace {
 CAIRN_REGISTER_CONTACT_LAW(GeneralContact, "general",
                            "sliding traction from the slide expression in Nc, vslip, t");
 

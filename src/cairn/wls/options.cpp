@@ -1,0 +1,52 @@
+// The WLS method's own input keys (seed 001; docs/wls.md), declared beside it, and the Options
+// they give the Integrator.
+#include "cairn/config/config.hpp"
+#include "cairn/config/plugin_keys.hpp"
+#include "cairn/wls/integrator.hpp"
+
+namespace cairn::wls {
+
+Options options(const MethodConfig& method) {
+  Options o;
+  o.trigger_weight = method.plugin.real("trigger_weight");
+  o.projected_distance = method.plugin.text("surface_distance") == "projection";
+  o.average_per_mass = method.plugin.text("spurious_force") == "per_mass";
+  o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
+  o.filter_acceleration = method.plugin.boolean("filter_acceleration");
+  return o;
+}
+
+CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
+    Key("", "trigger_weight", KeyType::real,
+      "WLS trigger weight TW (seed 001 Sec. 3.5): a node whose particles all have a "
+      "wide weight W below TW is spurious (constant fit, averaged internal force).")
+      .by_default("0.12")
+      .min(above_zero)
+      .max(1.0),
+    Key("", "surface_distance", KeyType::string,
+      "WLS signed distance of near-surface nodes (seed 001 Sec. 3.3): projection of "
+      "x_surf - x_i on the unit normal (the text) or distance |x_surf - x_i| with the "
+      "normal's sign (Eq. 17 as printed).")
+      .by_default("\"distance\"")
+      .choices([] { return std::vector<std::string>{"projection", "distance"}; }),
+    Key("", "spurious_force", KeyType::string,
+      "WLS internal force of spurious nodes (seed 001 Sec. 4.5): per_mass = the node "
+      "mass times the mean f_int / m of its well-conditioned neighbours; force = the "
+      "mean f_int of those neighbours (docs/wls.md).")
+      .by_default("\"per_mass\"")
+      .choices([] { return std::vector<std::string>{"per_mass", "force"}; }),
+    Key("", "velocity_gradient", KeyType::string,
+      "WLS particle velocity gradient: quadrature = the gradients at the integration "
+      "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
+      "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed, "
+      "unstable at free surfaces in our runs; docs/wls.md).")
+      .by_default("\"quadrature\"")
+      .choices([] { return std::vector<std::string>{"quadrature", "narrow"}; }),
+    Key("", "filter_acceleration", KeyType::boolean,
+      "WLS: replace each node's velocity increment a dt by the planar least-squares "
+      "fit over it and its neighbours with mass (weights W m), so linear fields pass "
+      "and the node-to-node zig-zag of small cut cells does not (docs/wls.md; not "
+      "energy conserving); false = seed 001 as printed.")
+      .by_default("false")}});
+
+}  // namespace cairn::wls

@@ -1,0 +1,34 @@
+#include "cairn/wls/step.hpp"
+
+namespace cairn::wls {
+
+template <int D>
+void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
+          NodeField<D>& nodes, const std::vector<double>& density0, double dt) {
+  wls.build_stencils(grid, particles);
+  engine.lap(0);
+  // Sec. 4.1-4.5: node mass, least-squares velocity (as m v) and forces.
+  const std::vector<Vec<D>>* body = engine.body_accelerations();
+  wls.collect(grid, particles, density0, body, nodes, body ? engine.node_body_forces() : nullptr);
+  engine.prepare_conditions(dt);
+  engine.lap(1);
+  engine.update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)
+  if (wls.options().filter_acceleration) {
+    wls.filter_acceleration(grid, nodes);
+    engine.impose_end_conditions();
+  }
+  engine.lap(2);
+  wls.move_particles(grid, nodes, particles, dt);  // Eq. 27-29 (or the quadrature gradient)
+  engine.lap(4);
+  engine.update_materials(wls.particle_velocity_gradient(), dt);  // Eq. 30
+  engine.lap(5);
+}
+
+template void step<1>(Integrator<1>&, EngineStages<1>&, const Grid<1>&, Particles<1>&, NodeField<1>&,
+                      const std::vector<double>&, double);
+template void step<2>(Integrator<2>&, EngineStages<2>&, const Grid<2>&, Particles<2>&, NodeField<2>&,
+                      const std::vector<double>&, double);
+template void step<3>(Integrator<3>&, EngineStages<3>&, const Grid<3>&, Particles<3>&, NodeField<3>&,
+                      const std::vector<double>&, double);
+
+}  // namespace cairn::wls

@@ -1,0 +1,44 @@
+// One step of the WLS method of seed 001 Sec. 4 on an engine's grid, node fields and particles:
+// the method's collection (Sec. 4.1-4.5) replaces the particle transfers and its particle move
+// (Eq. 27-29) the scheme's; the grid update with its velocity conditions and the material update
+// (Eq. 30) are the engine's, asked for through EngineStages (sim/ implements it, so that this
+// folder stays below sim/).
+#pragma once
+
+#include <vector>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/wls/integrator.hpp"
+
+namespace cairn::wls {
+
+/// What the WLS step asks of the engine that runs it.
+template <int D>
+class EngineStages {
+ public:
+  virtual ~EngineStages() = default;
+  /// The body accelerations b_p of this step, computed now (null: no body force), and where the
+  /// S^T M b part of the node forces goes.
+  virtual const std::vector<Vec<D>>* body_accelerations() = 0;
+  virtual std::vector<Vec<D>>* node_body_forces() = 0;
+  /// The velocity conditions of this step, from the collected node masses.
+  virtual void prepare_conditions(double dt) = 0;
+  /// Eq. 25-26: v+ = v + a dt with the velocity conditions (half the first acceleration, Sec. 4.7).
+  virtual void update_grid(double dt) = 0;
+  /// The end-of-step velocity conditions on v+ again (after the filter changed it).
+  virtual void impose_end_conditions() = 0;
+  /// Eq. 30: F <- (I + L_p dt) F and the material stress of every particle from its velocity
+  /// gradient L_p; a failing particle stops the step (SimulationFailure).
+  virtual void update_materials(const std::vector<Eigen::Matrix<double, D, D>>& velocity_gradient, double dt) = 0;
+  /// The end of a timed stage (0 stencils, 1 particles to grid, 2 grid update, 4 particle update,
+  /// 5 stress update: Simulation::stage_times).
+  virtual void lap(int stage) = 0;
+};
+
+/// One step of length dt; `density0` is each material's initial density (Eq. 19).
+template <int D>
+void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
+          NodeField<D>& nodes, const std::vector<double>& density0, double dt);
+
+}  // namespace cairn::wls
