@@ -1,6 +1,9 @@
 #include "cairn/io/metadata.hpp"
 
+#include <algorithm>
+
 #include "cairn/io/hdf5_util.hpp"
+#include "cairn/materials/material.hpp"
 #include "cairn/util/sha256.hpp"
 
 namespace cairn {
@@ -13,6 +16,25 @@ OutputMetadata output_metadata(const Config& config) {
   for (const auto& body : config.bodies) m.body_names.push_back(body.name);
   m.input_toml = config.resolved_toml;
   m.compression = config.output.compression;
+  // The models' state variables, merged by name over the materials (a model is cheap to make).
+  const auto n_materials = config.materials.size();
+  for (std::size_t i = 0; i < n_materials; ++i) {
+    for (const auto& v : make_material(config.materials[i])->state_variables()) {
+      auto it = std::find_if(m.state_variables.begin(), m.state_variables.end(),
+                             [&](const auto& s) { return s.name == v.name; });
+      if (it == m.state_variables.end()) {
+        std::string unit = m.unit(v.unit);
+        if (v.per != Quantity::dimensionless) {
+          const std::string per = m.unit(v.per);
+          const bool compound = per.find_first_of("*/") != std::string::npos;
+          unit = (v.unit == Quantity::dimensionless ? "1" : unit) + "/" + (compound ? "(" + per + ")" : per);
+        }
+        m.state_variables.push_back({v.name, unit, v.description, std::vector<int>(n_materials, -1)});
+        it = m.state_variables.end() - 1;
+      }
+      it->index[i] = v.index;
+    }
+  }
   return m;
 }
 

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -174,6 +176,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   file_info.readable = true;
   file_info.current = true;
   file_info.n_particles = rows.total;
+  for (const auto& v : meta_.state_variables) file_info.state_variables.push_back(v.name);
   std::vector<double> node_mass, node_velocity, node_normal;
   std::vector<std::size_t> box_start, box_count, vbox_start, vbox_count;
   if (with_grid) {
@@ -273,6 +276,25 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
       h5::write_doubles_rows(gid, "temperature", zero.empty() ? arranged(particles.temperature, order, doubles) : zero.data(),
                              rows, 0, z);
       h5::describe_dataset(gid, "temperature", meta_.unit(Quantity::temperature), "temperature");
+      // The materials' state variables by name (Material::state_variables), NaN for particles
+      // whose material has no such variable; the group attribute lists them for the XDMF.
+      const auto width = static_cast<std::size_t>(particles.n_state_per_particle);
+      std::string listed;
+      for (const auto& v : meta_.state_variables) {
+        doubles.resize(n);
+        for (std::size_t p = 0; p < n; ++p) {
+          const std::size_t q = stored(p);
+          const auto m = static_cast<std::size_t>(particles.material[q]);
+          const int k = m < v.index.size() ? v.index[m] : -1;
+          doubles[p] = k >= 0 && static_cast<std::size_t>(k) < width ? particles.state[q * width + static_cast<std::size_t>(k)]
+                                                                     : std::numeric_limits<double>::quiet_NaN();
+        }
+        h5::write_doubles_rows(gid, v.name, doubles.data(), rows, 0, z);
+        h5::describe_dataset(gid, v.name, v.unit, v.description);
+        if (!listed.empty()) listed += ' ';
+        listed += v.name;
+      }
+      if (!listed.empty()) h5::write_string_attribute(gid, "state_variables", listed);
       h5::write_ints_rows(gid, "material", arranged(particles.material, order, ints), rows, z);
       h5::describe_dataset(gid, "material", "1", "index into /material_names");
       h5::write_ints_rows(gid, "body", arranged(particles.body, order, ints), rows, z);
@@ -330,6 +352,10 @@ const typename SnapshotWriter<D>::FileInfo& SnapshotWriter<D>::info(const std::s
       h5::Handle f = h5::open_file(path);
       h5::Handle g = h5::open_group(f.get(), "particles");
       const std::vector<std::size_t> shape = h5::dataset_shape(g.get(), "mass");
+      if (h5::has_attribute(g.get(), "state_variables")) {
+        std::istringstream names(h5::read_string_attribute(g.get(), "state_variables"));
+        for (std::string name; names >> name;) fi.state_variables.push_back(name);
+      }
       if (shape.size() == 1) {
         fi.n_particles = shape[0];
         fi.readable = true;
@@ -399,6 +425,8 @@ void SnapshotWriter<D>::write_xdmf() {
     attribute(parts, "pressure", "Scalar", n, false, file, "/particles/pressure");
     attribute(parts, "von_mises", "Scalar", n, false, file, "/particles/von_mises");
     attribute(parts, "temperature", "Scalar", n, false, file, "/particles/temperature");
+    for (const auto& name : fi.state_variables)
+      attribute(parts, name, "Scalar", n, false, file, "/particles/" + name);
     attribute(parts, "material", "Scalar", n, true, file, "/particles/material");
     attribute(parts, "body", "Scalar", n, true, file, "/particles/body");
     parts.append(std::string_view("      </Grid>\n"));

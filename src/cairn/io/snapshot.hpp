@@ -20,6 +20,9 @@
 //   /particles/stress                Cauchy sigma = tau / det F, n x 6, xx yy zz xy yz xz (VTK order)
 //   /particles/deformation_gradient  n x 9, row-major (F_xx, F_xy, F_xz, F_yx, ...), and its rows
 //     deformation_gradient_x/_y/_z (n x 3 virtual views, no extra data) for ParaView
+//   /particles/<state variable>      n: each material state variable by name and unit
+//     (Material::state_variables, e.g. equivalent_plastic_strain), NaN for particles of materials
+//     without it; the group attribute "state_variables" lists them
 //   /particles/material, body        int32, n (indices into /material_names, /body_names)
 //   /particles/id                    int64, n: the particle's number (creation order); a run on
 //                                    several MPI ranks stores its particles rank after rank
@@ -111,6 +114,7 @@ class SnapshotWriter {
     bool has_contact_normal = false;
     std::vector<std::size_t> node_shape;  ///< grid node array shape, slowest axis first
     std::vector<double> origin, spacing;  ///< x y z
+    std::vector<std::string> state_variables;  ///< their /particles arrays
   };
 
   const FileInfo& info(const std::string& file);

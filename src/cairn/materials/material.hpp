@@ -13,11 +13,23 @@
 
 #include "cairn/config/config.hpp"
 #include "cairn/config/keys.hpp"
+#include "cairn/config/units.hpp"
 #include "cairn/math/sym_mat3.hpp"
 #include "cairn/math/types.hpp"
 #include "cairn/util/registry.hpp"
 
 namespace cairn {
+
+/// A state variable a model keeps per particle, as the outputs name it (snapshots, the Python
+/// module): `name` is written as a snapshot array of its own, in the unit `unit` / `per` of the
+/// run's unit system (e.g. energy / mass: J/kg in SI).
+struct StateVariable {
+  std::string name;  ///< snake_case, e.g. "equivalent_plastic_strain"
+  int index = 0;     ///< position in the particle's n_state() doubles
+  Quantity unit = Quantity::dimensionless;
+  Quantity per = Quantity::dimensionless;
+  std::string description;
+};
 
 /// What a stress update sees of one particle.
 struct MaterialPoint {
@@ -79,6 +91,9 @@ class Material {
   /// update(point); models override it to write the six components directly, so that the hot
   /// loop makes one virtual call per particle and no 3x3 temporary.
   virtual void update_stress(const MaterialPoint& point, SymMat3& tau) const { tau = update(point); }
+
+  /// The state variables worth showing (a subset of the n_state() doubles), for the outputs.
+  [[nodiscard]] virtual std::vector<StateVariable> state_variables() const { return {}; }
 
   /// Messages the model has for the user since the last call (e.g. a warning said once per run);
   /// the run prints them between steps. Called from one thread.

@@ -24,7 +24,8 @@
 // the predictor U + tau_old : D dt / rho0. Temperature: dT = -gamma0 J T tr(D) dt (Grueneisen
 // heating, Gamma rho = gamma0 rho0) + (plastic + viscous work) / (rho0 c_v).
 //
-// State per particle: U, alpha (equivalent plastic strain), b_e (6 components).
+// State per particle: U, alpha (equivalent plastic strain), b_e (6 components), d alpha / dt of
+// the last step (output only).
 #include <cmath>
 
 #include "cairn/materials/elastic_constants.hpp"
@@ -34,7 +35,7 @@
 namespace cairn {
 namespace {
 
-enum State { U_ = 0, ALPHA = 1, BE = 2, N_STATE = 8 };
+enum State { U_ = 0, ALPHA = 1, BE = 2, ALPHA_RATE = 8, N_STATE = 9 };
 
 Mat3 load_be(const double* s) {
   Mat3 b;
@@ -72,6 +73,14 @@ class MieGruneisen final : public Material {
   void initialize_state(double* s) const override {
     for (int k = 0; k < N_STATE; ++k) s[k] = 0.0;
     store_be(s, Mat3::Identity());
+  }
+  std::vector<StateVariable> state_variables() const override {
+    return {{"equivalent_plastic_strain", ALPHA, Quantity::dimensionless, Quantity::dimensionless,
+             "equivalent plastic strain alpha (J2 radial return)"},
+            {"plastic_strain_rate", ALPHA_RATE, Quantity::dimensionless, Quantity::time,
+             "d alpha / dt over the last step"},
+            {"internal_energy", U_, Quantity::energy, Quantity::mass,
+             "internal energy per unit mass U (Mie-Grueneisen equation of state)"}};
   }
   double initial_temperature() const override { return T0_; }
   bool uses_temperature() const override { return true; }
@@ -153,6 +162,7 @@ class MieGruneisen final : public Material {
         plastic_work = std::sqrt(2.0 / 3.0) * yield_stress(st[ALPHA]) * dg;  // |s| dgamma
       }
     }
+    st[ALPHA_RATE] = pt.dt > 0.0 ? (st[ALPHA] - alpha) / pt.dt : 0.0;
     store_be(st, be);
     // Pressure with the predicted internal energy, plus artificial viscosity.
     const Mat3 D = 0.5 * (pt.L + pt.L.transpose());

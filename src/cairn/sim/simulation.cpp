@@ -367,6 +367,13 @@ void Simulation<D>::set_particles(Particles<D> particles) {
   // Set-up particles that were sorted (keep_particles_sorted): where each was, by id, for the
   // tractions' faces, which go back to id order (the storage order of `particles` below).
   const std::vector<std::int32_t> old_by_id = output_order();
+  // The models write n_state() doubles per particle: a checkpoint of another layout (an older
+  // Cairn, before mie_gruneisen kept its plastic strain rate) would let them write past it.
+  if (particles.n_state_per_particle != particles_.n_state_per_particle)
+    throw std::invalid_argument("the checkpoint stores " + std::to_string(particles.n_state_per_particle) +
+                                " material state variables per particle, this Cairn's materials keep " +
+                                std::to_string(particles_.n_state_per_particle) +
+                                " (a checkpoint of another version): start the run again with cairn run");
   particles_ = std::move(particles);
   if (distributed()) {
     distribution_.partition(particles_);
