@@ -1,5 +1,5 @@
 // Input for Python: configs from files, TOML text and dicts through the one validator of
-// `cairn run` (io/input.hpp), InputError with its attributes, and the declared keys.
+// `cairn run` (input/input.hpp), InputError with its attributes, and the declared keys.
 #include <pybind11/stl.h>
 #include <toml++/toml.h>
 

@@ -28,6 +28,7 @@
 #include "cairn/geometry/volume_mesh.hpp"
 #include "cairn/geometry/image.hpp"
 #include "cairn/input/schema.hpp"
+#include "cairn/input/schema_detail.hpp"
 #include "cairn/config/plugin_keys.hpp"
 #include "cairn/config/units.hpp"
 #include "cairn/materials/material.hpp"
@@ -84,11 +85,7 @@ inline std::string display(const Path& p) {
   return out;
 }
 
-inline std::string join(const std::vector<std::string>& items, const std::string& sep = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
-  return out;
-}
+using schema_detail::join;
 
 inline std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");

@@ -25,7 +25,7 @@ void declare_condition_keys(std::vector<KeyDecl>& k);
 std::string markdown_text();
 std::string plain_text();
 
-std::string join(const std::vector<std::string>& items, const std::string& sep);
+std::string join(const std::vector<std::string>& items, const std::string& sep = ", ");
 /// Copies of the declared keys of one section.
 std::vector<KeyDecl> copy_section(std::string_view section);
 
