@@ -55,7 +55,7 @@ class FemEngine final : public Engine {
 
   [[nodiscard]] std::string name() const override { return "fem"; }
   [[nodiscard]] const Config& config() const override { return config_; }
-  [[nodiscard]] const Comm& comm() const override { return Comm::serial(); }
+  [[nodiscard]] const Comm& comm() const override { return comm_; }
   [[nodiscard]] double time() const override { return solver_.time(); }
   [[nodiscard]] long long step_count() const override { return solver_.step_count(); }
   [[nodiscard]] std::int64_t items() const override { return static_cast<std::int64_t>(solver_.mesh().n_elements()); }
@@ -167,6 +167,7 @@ class FemEngine final : public Engine {
   }
 
   Config config_;
+  Comm comm_ = Comm::serial();  // the FEM runs on one rank (docs/fem.md)
   Solver solver_;
   std::filesystem::path dir_;
   HistoryWriter history_writer_;

@@ -256,7 +256,12 @@ template <int D>
 void Simulation<D>::compute_body_forces() {
   if (body_force_.empty()) return;
   const auto n = static_cast<std::int64_t>(particles_.n());
-  if (body_force_constant_) return;  // particles_to_grid reads body_force_value_
+  if (body_force_constant_) {
+    // particles_to_grid reads body_force_value_; the WLS fits take b_p per particle (seed 001
+    // Sec. 4.1, f_p = rho_p b_p), so they get the constant in every slot.
+    if (wls_) body_acceleration_.assign(particles_.n(), body_force_value_);
+    return;
+  }
   body_acceleration_.resize(particles_.n());
 #pragma omp parallel
   {
