@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 #include <sched.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -121,6 +122,20 @@ constexpr const char* threads_help =
 
 /// Largest -t: as simulation.threads (input/schema.cpp).
 constexpr int max_threads = 1024;
+
+/// "rank 2 of 4: " on a distributed run (an error of one rank stops them all), else nothing.
+std::string rank_prefix() {
+  const auto& world = cairn::Comm::world();
+  return world.parallel() ? fmt::format("rank {} of {}: ", world.rank(), world.size()) : std::string();
+}
+
+/// The address-space limit (`ulimit -v`) when one is set, for the out-of-memory message.
+std::string address_space_note() {
+  struct rlimit r {};
+  if (::getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return {};
+  return fmt::format("; the process's address-space limit (ulimit -v) is {:.3g} GiB",
+                     static_cast<double>(r.rlim_cur) / (1024.0 * 1024.0 * 1024.0));
+}
 
 }  // namespace
 
@@ -268,11 +283,13 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::bad_alloc&) {
     // Other ranks may be waiting in a collective call: on several ranks, stop them all.
-    std::cerr << "cairn: error: out of memory (simulation.memory_limit bounds the setup's estimate)\n";
+    std::cerr << "cairn: error: " << rank_prefix()
+              << "out of memory (simulation.memory_limit bounds the setup's estimate" << address_space_note()
+              << ")\n";
     if (cairn::Comm::world().parallel()) cairn::Comm::world().abort(1);
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "cairn: error: " << e.what() << "\n";
+    std::cerr << "cairn: error: " << rank_prefix() << e.what() << "\n";
     if (cairn::Comm::world().parallel()) cairn::Comm::world().abort(1);
     return 1;
   }

@@ -101,6 +101,27 @@ TEST(Robustness, MemoryIsEstimatedBeforeAllocating) {
   EXPECT_EQ(cairn_on("check", text, d, "--set simulation.memory_limit=1").code, 0);
 }
 
+// Without simulation.memory_limit, the address space that `ulimit -v` leaves free bounds the
+// estimate too, and the message names that limit (issue 36). Not in the sanitizer build: its
+// shadow memory needs an unlimited address space.
+TEST(Robustness, AddressSpaceLimitBoundsTheEstimate) {
+  const fs::path d = case_dir("ulimit");
+  std::string text = base_input();  // about 0.65 GiB: 6.4e5 particles and 1e6 nodes
+  text.replace(text.find("cell_size = 0.1"), 15, "cell_size = 1e-3");
+  write_text(d / "case.toml", text);
+  auto check = [&](const std::string& ulimit) {
+    const std::string cmd = "cd '" + d.string() + "' && " + ulimit + " OMP_NUM_THREADS=1 '" + CAIRN_BINARY +
+                            "' check case.toml > log.txt 2>&1";
+    const int status = std::system(("/bin/sh -c \"" + cmd + "\"").c_str());
+    return CliResult{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read_text(d / "log.txt")};
+  };
+  CliResult r = check("ulimit -v 500000 &&");  // KiB: under 0.5 GiB
+  EXPECT_TRUE(input_error(r, "case.toml:17", "body[0].particles_per_cell"));
+  EXPECT_NE(r.output.find("address-space limit (ulimit -v)"), std::string::npos) << r.output;
+  r = check("");
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
 /// Particle generation visits the lattice points in the body's bounds, not every grid cell: a
 /// small body on a 40000^2-cell grid with 16^2 particles per cell (4e11 lattice points) is quick.
 /// (The Grid holds geometry only; nothing is allocated per node here.)

@@ -44,6 +44,7 @@ struct SimulationConfig {
   double memory_limit = 0.0;  ///< GiB the setup may need; 0: the machine's memory
   double rebalance_threshold = 0.25;  ///< MPI: repartition when max/mean particles - 1 exceeds it
   double max_estimated_steps = 1e8;  ///< refuse end_time / first dt above this; 0: no check
+  double mpi_timeout = 300.0;  ///< MPI: s without a completed step before the run stops; 0: never
   std::string body_overlap = "error";  ///< bodies sharing space: error | warn
   SourceLocation where;     ///< the [simulation] table (end_time's line when given)
 };

@@ -85,6 +85,14 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "limit when lower). A larger estimate is refused, naming the keys that drive it.")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("simulation", "mpi_timeout", T::real,
+                 "Seconds a distributed run waits for a step to complete before it stops, naming "
+                 "the rank that stopped answering (stopped, hung, or lost with its node; a killed "
+                 "or failing rank stops the run at once); exit code 1. 0 = wait for ever. Counted "
+                 "from the first step (set-up and the final output are not timed). Unused on one "
+                 "rank. docs/robustness.md.")
+                .by_default("300.0")
+                .min(0.0));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,
                  "Refuse a run whose end_time / first time step exceeds this (a run that would "
                  "never end), naming the material that sets the step; 0 = no check. Not checked "

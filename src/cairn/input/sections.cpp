@@ -72,6 +72,7 @@ void Loader::read_simulation(const toml::table& root, Config& cfg) {
   s.memory_limit = r.real("memory_limit");
   s.rebalance_threshold = r.real("rebalance_threshold");
   s.max_estimated_steps = r.real("max_estimated_steps");
+  s.mpi_timeout = r.real("mpi_timeout");
   s.body_overlap = r.string("body_overlap");
   s.where = locate(r.path_of("end_time"), r.given("end_time") ? r.given("end_time") : section(root, "simulation"));
 }

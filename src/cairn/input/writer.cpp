@@ -98,6 +98,7 @@ std::string config_to_toml(const Config& c) {
   line("units", toml_string(s.units));
   line("memory_limit", real_text(s.memory_limit));
   line("max_estimated_steps", real_text(s.max_estimated_steps));
+  line("mpi_timeout", real_text(s.mpi_timeout));
   line("body_overlap", toml_string(s.body_overlap));
 
   if (!c.fem.enabled) {

@@ -13,6 +13,7 @@
 #include "cairn/config/errors.hpp"
 #include "cairn/io/checkpoint.hpp"
 #include "cairn/parallel/comm.hpp"
+#include "cairn/run/watchdog.hpp"
 
 namespace cairn {
 namespace {
@@ -199,7 +200,7 @@ const std::vector<std::string>& restart_keys() {
   static const std::vector<std::string> keys{
       "simulation.end_time",        "simulation.max_steps",       "simulation.threads",
       "simulation.adapt_threads",   "simulation.sort_particles",  "simulation.rebalance_threshold",
-      "simulation.memory_limit",    "simulation.max_estimated_steps",
+      "simulation.memory_limit",    "simulation.max_estimated_steps", "simulation.mpi_timeout",
       "output.directory",           "output.every",               "output.history_every",
       "output.checkpoint_every",    "output.checkpoint_wall_interval", "output.checkpoints",
       "output.snapshots",           "output.grid_snapshots",      "output.compression"};
@@ -246,9 +247,15 @@ RunSummary drive(Engine& engine, const RunOptions& options) {
   const StopSignals signals;
   Progress progress(engine, options.quiet || !engine.comm().is_root());  // (ends its line however this ends)
   engine.start();
-  while (!engine.finished()) {
-    engine.step();
-    progress.update();
+  {
+    StallWatchdog watchdog(engine.comm(), engine.config().simulation.mpi_timeout, engine.config().output.directory);
+    const FaultInjection fault(engine.comm());
+    while (!engine.finished()) {
+      engine.step();
+      fault.after_step(engine.step_count());
+      watchdog.beat(engine.step_count());
+      progress.update();
+    }
   }
   RunSummary summary = engine.finish();
   progress.update(true);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,6 +50,28 @@ double machine_memory_bytes() {
     if (in >> limit && limit > 0.0) bytes = std::min(bytes, limit);  // "max" fails to parse: no limit
   }
   return bytes;
+}
+
+/// Bytes the address-space limit (`ulimit -v`, RLIMIT_AS) leaves for the run's data: the limit
+/// less what the process maps already (code, libraries, thread stacks); infinite without one.
+double address_space_room() {
+  struct rlimit r {};
+  if (::getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return std::numeric_limits<double>::infinity();
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0.0;
+  statm >> pages;
+  return std::max(0.0, static_cast<double>(r.rlim_cur) - pages * static_cast<double>(::sysconf(_SC_PAGE_SIZE)));
+}
+
+/// The limit memory_limit_bytes() returns, in words for a message.
+std::string memory_limit_text(const Config& config, double limit) {
+  if (config.simulation.memory_limit > 0.0)
+    return fmt::format("simulation.memory_limit = {:.4g} GiB", config.simulation.memory_limit);
+  if (limit < machine_memory_bytes())
+    return fmt::format("the {:.4g} GiB that the process's address-space limit (ulimit -v) leaves free "
+                       "(simulation.memory_limit = 0)",
+                       limit / gib);
+  return fmt::format("this machine's {:.4g} GiB (simulation.memory_limit = 0)", limit / gib);
 }
 
 }  // namespace
@@ -212,7 +235,7 @@ void check_node_count(const Config& config, const std::vector<long long>& n_cell
 
 double memory_limit_bytes(const Config& config) {
   if (config.simulation.memory_limit > 0.0) return config.simulation.memory_limit * gib;
-  return machine_memory_bytes();
+  return std::min(machine_memory_bytes(), address_space_room());
 }
 
 template <int D>
@@ -266,10 +289,7 @@ void check_memory(const Config& config, const Grid<D>& grid, int n_fields, int n
   const bool too_many = share * particles > static_cast<double>(INT32_MAX);
   if (bytes <= limit && !too_many) return;
 
-  const std::string limit_text =
-      config.simulation.memory_limit > 0.0
-          ? fmt::format("simulation.memory_limit = {:.4g} GiB", config.simulation.memory_limit)
-          : fmt::format("this machine's {:.4g} GiB (simulation.memory_limit = 0)", limit / gib);
+  const std::string limit_text = memory_limit_text(config, limit);
   std::string found = fmt::format(
       "an estimated {:.3g} GiB: {:.3g} particles x {:.0f} bytes (largest {}) and {:.3g} grid "
       "nodes x {} field(s) x {:.0f} bytes (grid.cell_size)",

@@ -66,7 +66,7 @@ void check_node_count(const Config& config, const std::vector<long long>& n_cell
 int velocity_fields(const Config& config);
 
 /// Bytes the limit allows: simulation.memory_limit GiB, else the machine's memory (the cgroup
-/// limit when lower).
+/// limit when lower, and what the address-space limit `ulimit -v` leaves free when lower still).
 double memory_limit_bytes(const Config& config);
 
 /// Estimate the memory of grid, particles and transfer caches before anything is allocated;
