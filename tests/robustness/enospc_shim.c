@@ -1,7 +1,8 @@
 /* A write failure to inject with LD_PRELOAD: write(), pwrite() and their 64-bit and vector
  * variants return -1 with errno = ENOSPC ("no space left on device") for files whose path
  * contains CAIRN_ENOSPC_MATCH, once CAIRN_ENOSPC_AFTER bytes (default 0) have been written to
- * such files. Everything else passes through. It stands in for a full disk in the robustness
+ * such files (CAIRN_ENOSPC_ERRNO, a number, picks another errno: EDQUOT for a quota, EIO for a
+ * failing device). Everything else passes through. It stands in for a full disk in the robustness
  * tests: mounting a small tmpfs needs privileges a CI container may not have.
  *
  * HDF5 (sec2 driver) and the output layer call these through the dynamic linker, so the
@@ -35,7 +36,8 @@ static int must_fail(int fd, size_t count) {
     written += (long long)count;
     return 0;
   }
-  errno = ENOSPC;
+  const char* code = getenv("CAIRN_ENOSPC_ERRNO");
+  errno = code ? atoi(code) : ENOSPC;
   return 1;
 }
 

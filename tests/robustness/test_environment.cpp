@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <utility>
 #include <regex>
 
 #include "cairn/io/atomic_file.hpp"
@@ -154,6 +156,47 @@ TEST(Robustness, FullDiskSaysSoAndKeepsTheHistory) {
   r = cairn_on("run", base_input(), d, "-q --set output.directory='\"out2\"'", shim + "CAIRN_ENOSPC_MATCH=history.csv");
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("no space left on device"), std::string::npos) << r.output;
+}
+
+// A disk quota and a failing device mid-run (issue 36): the same path as a full disk, each named.
+TEST(Robustness, QuotaAndDeviceErrorsSaySoAndKeepTheHistory) {
+  const fs::path d = case_dir("quota");
+  const std::string shim = std::string("LD_PRELOAD='") + CAIRN_ENOSPC_SHIM + "' CAIRN_ENOSPC_MATCH=checkpoint- ";
+  for (const auto& [code, says] : {std::pair{EDQUOT, "disk quota exceeded"}, std::pair{EIO, "Input/output error"}}) {
+    const std::string out = "out" + std::to_string(code);
+    const CliResult r = cairn_on("run", base_input(), d,
+                                 "-q --set output.checkpoint_every=3e-3 --set output.directory='\"" + out + "\"'",
+                                 shim + "CAIRN_ENOSPC_ERRNO=" + std::to_string(code));
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+    const std::string history = read_text(d / out / "history.csv");
+    EXPECT_GE(std::count(history.begin(), history.end(), '\n') - 1, 3) << history;
+  }
+}
+
+// A read-only output folder (issue 36): exit 1 naming the file and the reason, nothing written.
+// Root may write anywhere, so as root the run is made by the user nobody (runuser).
+TEST(Robustness, ReadOnlyOutputFolderSaysSo) {
+  const fs::path d = case_dir("readonly");
+  write_text(d / "case.toml", base_input());
+  fs::create_directories(d / "out");
+  fs::permissions(d, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                         fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(d / "case.toml", fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read |
+                                       fs::perms::others_read);
+  fs::permissions(d / "out", fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                 fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
+  const std::string as = ::geteuid() == 0 ? "runuser -u nobody -- " : "";
+  const std::string cmd = "cd '" + d.string() + "' && OMP_NUM_THREADS=1 " + as + "'" + CAIRN_BINARY +
+                          "' run case.toml -q --set output.directory='\"out\"' > '" + (d / "log.txt").string() +
+                          "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string log = read_text(d / "log.txt");
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status << log;
+  EXPECT_NE(log.find("out/history.csv"), std::string::npos) << log;
+  EXPECT_NE(log.find("Permission denied"), std::string::npos) << log;
+  EXPECT_TRUE(fs::is_empty(d / "out"));
+  fs::permissions(d / "out", fs::perms::owner_all, fs::perm_options::add);
 }
 
 TEST(Robustness, PlantedSymlinksDoNotRedirectWrites) {

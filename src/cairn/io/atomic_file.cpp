@@ -73,11 +73,14 @@ void write_file_atomically(const fs::path& target,
     writer(tmp);
   } catch (const std::runtime_error& e) {
     // Libraries (HDF5) report a failed write without errno; a full disk is worth saying.
+    // Besides a full disk, the errors of the device or file system itself are worth saying
+    // (other errno values may be left over from a library's harmless probing).
     const int err = errno;
     const bool full = err == ENOSPC || err == EDQUOT || file_system_full(parent);
+    const bool device = err == EIO || err == EROFS || err == EFBIG;
     discard_tmp();
-    if (!full) throw;
-    const std::string why = reason(err == EDQUOT ? EDQUOT : ENOSPC);
+    if (!full && !device) throw;
+    const std::string why = reason(full ? (err == EDQUOT ? EDQUOT : ENOSPC) : err);
     if (std::string(e.what()).find(why) != std::string::npos) throw;
     throw std::runtime_error("cannot write '" + target.string() + "': " + why + " (" + e.what() + ")");
   } catch (...) {
