@@ -53,7 +53,7 @@ struct Options {
   /// Values at the integration points (Eq. 19-21): true = each well-conditioned corner's planar
   /// fit evaluated at the point (Eq. 10 at r = x_q - x_i), so linear fields are reproduced also
   /// where some corners are spurious; false = the corners' node values c0 (Eq. 19-21 as printed).
-  bool fitted_point_values = true;
+  bool fitted_point_values = false;
   /// Velocity of a spurious node: true = mean of its well-conditioned neighbours' planar velocity
   /// fits evaluated at the node (linear fields reproduced); false = its constant fit c0 (Sec. 3.5
   /// as printed: a weighted mean of particle velocities about a cell away).

@@ -43,7 +43,7 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "WLS density, body force and stress at the integration points (seed 001 Eq. 19-21): "
       "node = the well-conditioned corners' node values c0 (as printed); fit = their "
       "planar fits (Eq. 10) evaluated at the point, exact for linear fields (docs/wls.md).")
-      .by_default("\"fit\"")
+      .by_default("\"node\"")
       .choices([] { return std::vector<std::string>{"node", "fit"}; }),
     Key("", "spurious_velocity", KeyType::string,
       "WLS velocity of spurious nodes (seed 001 Sec. 3.5): constant = the reduced fit c0 "
