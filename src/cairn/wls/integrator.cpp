@@ -18,6 +18,28 @@ namespace {
 
 constexpr int pow3(int d) { return d == 0 ? 1 : 3 * pow3(d - 1); }
 
+/// fn(nb, offset) for every node nb of the 3^D block around node i (itself included) that the
+/// grid holds; offset = position of nb minus that of i, in cells.
+template <int D, class Fn>
+void for_each_neighbour(const Grid<D>& grid, std::int32_t i, Fn&& fn) {
+  const IVec<D> j = grid.multi_index(i);
+  std::array<int, D> k{};
+  for (int s = 0; s < pow3(D); ++s) {
+    IVec<D> jn = j;
+    Vec<D> offset;
+    for (int a = 0; a < D; ++a) {
+      jn[a] += k[a] - 1;
+      offset[a] = k[a] - 1;
+    }
+    for (int a = 0; a < D; ++a) {
+      if (++k[a] < 3) break;
+      k[a] = 0;
+    }
+    const std::int32_t nb = grid.node_index(jn);
+    if (nb >= 0) fn(nb, offset);
+  }
+}
+
 /// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
 constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
 
@@ -57,6 +79,7 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   const std::int32_t n = grid.n_nodes();
   moment_.assign(n, {});
   load_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
+  coef_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
   max_weight_.assign(n, 0.0);
   count_.assign(n, 0);
   beta_.assign(n, 0.0);
@@ -221,6 +244,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     for (std::size_t s = base; s < base + slots; ++s) entry(p, s);
   });
   fit_nodes(grid, n_used);
+  if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
   integrate(grid, body_force, nodes, node_body_force);
@@ -255,6 +279,8 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     stress_[i].setZero();
     inverse_[i].setZero();
     alpha_[i] = 0;
+    double* coef = &coef_[static_cast<std::size_t>(i) * n_fields * n_basis];
+    std::fill_n(coef, n_fields * n_basis, 0.0);
     if (count_[i] == 0) return;
     Eigen::Matrix<double, n_basis, n_basis> M;
     for (int r = 0; r < n_basis; ++r)
@@ -266,11 +292,10 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     alpha_[i] = reduced ? 0 : 1;
     if (reduced) ++spurious[static_cast<std::size_t>(omp_get_thread_num())];
     const double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
-    auto value = [&](int k) {  // c0 of field k (Eq. 10-11)
-      double c0 = 0.0;
-      for (int r = 0; r < n_basis; ++r) c0 += inverse_[i](0, r) * l[k * n_basis + r];
-      return c0;
-    };
+    for (int k = 0; k < n_used; ++k)  // c = M^-1 l of field k (Eq. 10); zero slopes where reduced
+      for (int c = 0; c < n_basis; ++c)
+        for (int r = 0; r < n_basis; ++r) coef[k * n_basis + c] += inverse_[i](c, r) * l[k * n_basis + r];
+    auto value = [&](int k) { return coef[k * n_basis]; };  // c0 of field k (Eq. 11)
     for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
     density_[i] = value(D);
     for (int a = 0; a < D; ++a)
@@ -293,6 +318,40 @@ Eigen::Matrix<double, D, D> Integrator<D>::velocity_gradient_fit(std::int32_t i)
       L(a, b) = c / h_[b];  // Eq. 12, back from cell units
     }
   return L;
+}
+
+template <int D>
+Eigen::Matrix<double, D + 1, D + 1> Integrator<D>::moment_matrix(std::int32_t i) const {
+  Eigen::Matrix<double, n_basis, n_basis> M;
+  for (int r = 0; r < n_basis; ++r)
+    for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = moment_[i][packed(r, c, n_basis)];
+  return M;
+}
+
+template <int D>
+void Integrator<D>::extrapolate_spurious_velocity(const Grid<D>& grid) {
+  // A spurious node's velocity: the mean of its well-conditioned neighbours' planar velocity fits
+  // (Eq. 10) evaluated at the node, so that a linear velocity field is exact there too
+  // (docs/wls.md). Written to a scratch first: neighbours read the fits, not the new values.
+  const std::int32_t n_nodes = grid.n_nodes();
+  filtered_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    filtered_[i] = velocity_[i];
+    if (alpha_[i] || count_[i] == 0) return;
+    Vec<D> sum = Vec<D>::Zero();
+    int n = 0;
+    for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& offset) {
+      if (!alpha_[nb]) return;
+      const double* coef = &coef_[static_cast<std::size_t>(nb) * n_fields * n_basis];
+      for (int a = 0; a < D; ++a) {  // velocity component a is field a; x_i - x_nb = -offset
+        sum[a] += coef[a * n_basis];
+        for (int b = 0; b < D; ++b) sum[a] -= coef[a * n_basis + 1 + b] * offset[b];
+      }
+      ++n;
+    });
+    if (n > 0) filtered_[i] = sum / n;
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) { velocity_[i] = filtered_[i]; });
 }
 
 template <int D>
@@ -390,6 +449,7 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
         // Eq. 19-21: values at the point from the well-conditioned corners (alpha_i = 1); a
         // cell whose corners are all spurious falls back to all of them.
         const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+        const bool fitted = options_.fitted_point_values;
         for (int pass = 0; pass < 2; ++pass) {
           double sum = 0.0;
           q.density = 0.0;
@@ -401,9 +461,31 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
             Vec<D> G;
             corner_shape<D>(k, local, inv_h, S, G);
             sum += S;
-            q.density += S * density_[node[k]];
-            q.force_density += S * force_density_[node[k]];
-            q.stress += S * stress_[node[k]];
+            if (!fitted) {
+              q.density += S * density_[node[k]];
+              q.force_density += S * force_density_[node[k]];
+              q.stress += S * stress_[node[k]];
+              continue;
+            }
+            // The corner's planar fits at the point (Eq. 10 at r = x_q - x_k, in cells); a
+            // reduced fit has zero slopes and gives its c0.
+            Vec<D> r;
+            for (int a = 0; a < D; ++a) r[a] = local[a] - ((k >> a) & 1);
+            const double* c = &coef_[static_cast<std::size_t>(node[k]) * n_fields * n_basis];
+            auto at = [&](int field) {
+              double v = c[field * n_basis];
+              for (int a = 0; a < D; ++a) v += c[field * n_basis + 1 + a] * r[a];
+              return v;
+            };
+            q.density += S * at(D);
+            for (int a = 0; a < D; ++a) {
+              q.force_density[a] += S * at(D + 1 + n_stress + a);
+              for (int b = a; b < D; ++b) {
+                const double v = S * at(D + 1 + voigt<D>(a, b));
+                q.stress(a, b) += v;
+                if (b != a) q.stress(b, a) += v;
+              }
+            }
           }
           if (sum > 0.0) {
             q.density /= sum;
@@ -466,28 +548,14 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
   // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
   for_each_node(n_nodes, [&](std::int32_t i) {
     Vec<D> fi = internal_force_[i];
-    if (!alpha_[i] && nodes.mass[i] > 0.0) {
-      const IVec<D> j = grid.multi_index(i);
+    if (!alpha_[i] && nodes.mass[i] > 0.0 && !options_.integrated_spurious_force) {
       Vec<D> sum = Vec<D>::Zero();
       int n = 0;
-      std::array<int, D> k{};
-      for (int s = 0; s < pow3(D); ++s) {
-        IVec<D> jn = j;
-        bool self = true;
-        for (int a = 0; a < D; ++a) {
-          jn[a] += k[a] - 1;
-          self &= k[a] == 1;
-        }
-        for (int a = 0; a < D; ++a) {
-          if (++k[a] < 3) break;
-          k[a] = 0;
-        }
-        if (self) continue;
-        const std::int32_t nb = grid.node_index(jn);
-        if (nb < 0 || !alpha_[nb] || !(nodes.mass[nb] > 0.0)) continue;
+      for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>&) {
+        if (nb == i || !alpha_[nb] || !(nodes.mass[nb] > 0.0)) return;
         sum += options_.average_per_mass ? Vec<D>(internal_force_[nb] / nodes.mass[nb]) : internal_force_[nb];
         ++n;
-      }
+      });
       fi = n == 0 ? Vec<D>::Zero() : Vec<D>(sum / n);
       if (options_.average_per_mass) fi *= nodes.mass[i];
     }
@@ -506,30 +574,17 @@ void Integrator<D>::filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes
   for_each_node(n_nodes, [&](std::int32_t i) {
     filtered_[i] = nodes.velocity_new[i] - nodes.velocity[i];
     if (!(nodes.mass[i] > 0.0)) return;
-    const IVec<D> j = grid.multi_index(i);
     typename PlaneFit<D>::Matrix M = PlaneFit<D>::Matrix::Zero();
     Eigen::Matrix<double, n_basis, D> load = Eigen::Matrix<double, n_basis, D>::Zero();
-    std::array<int, D> k{};
-    for (int s = 0; s < pow3(D); ++s) {
-      IVec<D> jn = j;
-      Vec<D> r;
+    for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& r) {
+      if (!(nodes.mass[nb] > 0.0)) return;
       double w = 1.0;
-      for (int a = 0; a < D; ++a) {
-        jn[a] += k[a] - 1;
-        r[a] = k[a] - 1;
-        w *= wide_weight(r[a], 1.0);
-      }
-      for (int a = 0; a < D; ++a) {
-        if (++k[a] < 3) break;
-        k[a] = 0;
-      }
-      const std::int32_t nb = grid.node_index(jn);
-      if (nb < 0 || !(nodes.mass[nb] > 0.0)) continue;
+      for (int a = 0; a < D; ++a) w *= wide_weight(r[a], 1.0);
       w *= nodes.mass[nb];
       const auto b = PlaneFit<D>::basis(r);
       M += w * b * b.transpose();
       load += w * b * (nodes.velocity_new[nb] - nodes.velocity[nb]).transpose();
-    }
+    });
     const auto inverse = PlaneFit<D>::inverse(M, false);
     filtered_[i] = (inverse.row(0) * load).transpose();
   });

@@ -47,6 +47,17 @@ struct Options {
   /// Spurious-node internal force (Sec. 3.5, 4.5): true = mean of the neighbours' internal
   /// force per unit mass, times the node's mass; false = mean of the neighbours' internal force.
   bool average_per_mass = true;
+  /// Spurious-node internal force: false = replaced by the neighbours' mean (Sec. 3.5, 4.5, as
+  /// above); true = the node's own integral Eq. 24 like every other node (docs/wls.md).
+  bool integrated_spurious_force = false;
+  /// Values at the integration points (Eq. 19-21): true = each well-conditioned corner's planar
+  /// fit evaluated at the point (Eq. 10 at r = x_q - x_i), so linear fields are reproduced also
+  /// where some corners are spurious; false = the corners' node values c0 (Eq. 19-21 as printed).
+  bool fitted_point_values = false;
+  /// Velocity of a spurious node: true = mean of its well-conditioned neighbours' planar velocity
+  /// fits evaluated at the node (linear fields reproduced); false = its constant fit c0 (Sec. 3.5
+  /// as printed: a weighted mean of particle velocities about a cell away).
+  bool extrapolated_spurious_velocity = false;
   /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches): node
   /// flags count the mirror image and surface positions of nodes on it lie in it.
   std::array<bool, 6> mirror{};
@@ -116,6 +127,8 @@ class Integrator {
   [[nodiscard]] const std::vector<double>& node_flags() const { return beta_; }
   /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced.
   [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
+  /// Moment matrix M of node i (Eq. 9, r in cells) from the last collect.
+  [[nodiscard]] Eigen::Matrix<double, D + 1, D + 1> moment_matrix(std::int32_t i) const;
   /// grad V_p of every particle from the last move_particles (the F and stress update's L).
   [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
     return particle_gradient_;
@@ -129,6 +142,7 @@ class Integrator {
   static constexpr int n_fields = 2 * D + 1 + n_stress;
 
   void fit_nodes(const Grid<D>& grid, int n_used_fields);
+  void extrapolate_spurious_velocity(const Grid<D>& grid);
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
   void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force);
@@ -157,6 +171,7 @@ class Integrator {
   std::vector<Vec<D>> force_density_;
   std::vector<Eigen::Matrix<double, D, D>> stress_;
   std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
+  std::vector<double> coef_;           ///< n_nodes x n_fields x n_basis: M^-1 l (Eq. 10), r in cells
   std::vector<std::uint8_t> alpha_;
   std::vector<double> distance_;
   std::vector<Vec<D>> internal_force_;

@@ -11,6 +11,9 @@ Options options(const MethodConfig& method) {
   o.trigger_weight = method.plugin.real("trigger_weight");
   o.projected_distance = method.plugin.text("surface_distance") == "projection";
   o.average_per_mass = method.plugin.text("spurious_force") == "per_mass";
+  o.integrated_spurious_force = method.plugin.text("spurious_force") == "integrated";
+  o.fitted_point_values = method.plugin.text("point_values") == "fit";
+  o.extrapolated_spurious_velocity = method.plugin.text("spurious_velocity") == "neighbours";
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
   return o;
@@ -32,9 +35,22 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
     Key("", "spurious_force", KeyType::string,
       "WLS internal force of spurious nodes (seed 001 Sec. 4.5): per_mass = the node "
       "mass times the mean f_int / m of its well-conditioned neighbours; force = the "
-      "mean f_int of those neighbours (docs/wls.md).")
+      "mean f_int of those neighbours; integrated = the node's own Eq. 24 like every "
+      "node (docs/wls.md).")
       .by_default("\"per_mass\"")
-      .choices([] { return std::vector<std::string>{"per_mass", "force"}; }),
+      .choices([] { return std::vector<std::string>{"per_mass", "force", "integrated"}; }),
+    Key("", "point_values", KeyType::string,
+      "WLS density, body force and stress at the integration points (seed 001 Eq. 19-21): "
+      "node = the well-conditioned corners' node values c0 (as printed); fit = their "
+      "planar fits (Eq. 10) evaluated at the point, exact for linear fields (docs/wls.md).")
+      .by_default("\"node\"")
+      .choices([] { return std::vector<std::string>{"node", "fit"}; }),
+    Key("", "spurious_velocity", KeyType::string,
+      "WLS velocity of spurious nodes (seed 001 Sec. 3.5): constant = the reduced fit c0 "
+      "(as printed); neighbours = the mean of the well-conditioned neighbours' planar "
+      "velocity fits at the node, exact for linear fields (docs/wls.md).")
+      .by_default("\"constant\"")
+      .choices([] { return std::vector<std::string>{"constant", "neighbours"}; }),
     Key("", "velocity_gradient", KeyType::string,
       "WLS particle velocity gradient: quadrature = the gradients at the integration "
       "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
