@@ -84,36 +84,47 @@ def main():
     print(f"soak: uninterrupted run took {wall / 60:.1f} min", flush=True)
 
     killed = args.out / "killed"
-    kills, restarts, at = 0, 0, 0
+    # Kill moments by progress, not by the clock (a shared machine's speed varies): after a
+    # randomly chosen checkpoint appears, within a random fraction of the interval since the one
+    # before, so that a kill lands inside a step or inside a checkpoint's writing.
+    total = int(steps * dt / every)
+    targets = sorted(rng.sample(range(1, max(total - 3, args.kills + 1)), args.kills))
+    kills, restarts = 0, 0
     cmd = command(args, args.ranks, "run", CASE, killed, steps, settings(every))
     while True:
         job = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                start_new_session=True)
-        # A random moment within this leg's share of the steps still to go, so that every kill
-        # lands before the end.
-        left = wall * (steps - at) / steps
-        deadline = rng.uniform(0.3, 0.9) * left / (args.kills - kills) if kills < args.kills else None
-        try:
-            _, err = job.communicate(timeout=deadline)
+        target = killed / f"checkpoint-{targets[kills]:04d}.h5" if kills < args.kills else None
+        before = killed / f"checkpoint-{targets[kills] - 1:04d}.h5" if target is not None else None
+        seen_before = None  # when the checkpoint before the target appeared: the live interval
+        while job.poll() is None and target is not None and not target.exists():
+            if seen_before is None and before.exists():
+                seen_before = time.monotonic()
+            time.sleep(0.01)
+        if job.poll() is None and target is not None:
+            interval = time.monotonic() - seen_before if seen_before is not None else 0.1
+            time.sleep(rng.uniform(0.0, 0.8) * interval)
+        if job.poll() is not None or target is None:
+            _, err = job.communicate()
             if job.returncode != 0:
                 print(f"RESULT: FAIL (restart {restarts} exited {job.returncode}: {err.strip()[-400:]})")
                 return 1
+            if target is not None:  # the machine sped up: the run ended before this kill
+                print(f"soak: the run ended before kill {kills + 1} ({target.name})", flush=True)
             break
-        except subprocess.TimeoutExpired:
-            os.killpg(job.pid, signal.SIGKILL)  # the launcher and every rank at once
-            job.communicate()
-            kills += 1
+        os.killpg(job.pid, signal.SIGKILL)  # the launcher and every rank at once
+        job.communicate()
+        kills += 1
         checkpoint = newest_checkpoint(killed)
-        if checkpoint is None:
-            cmd = command(args, args.ranks, "run", CASE, killed, steps, settings(every))
-            print(f"soak: kill {kills} before the first checkpoint: starting again", flush=True)
-            continue
         with h5py.File(checkpoint, "r") as f:
             at = int(f.attrs["step"])
         print(f"soak: kill {kills} (SIGKILL); restart {restarts + 1} from {checkpoint.name} (step {at}) "
               f"on {restart_ranks} rank(s)", flush=True)
         cmd = command(args, restart_ranks, "restart", checkpoint, killed, steps)
         restarts += 1
+        # A restart must not meet a target already behind it.
+        while kills < args.kills and targets[kills] <= int(checkpoint.stem.split("-")[1]):
+            targets[kills] = int(checkpoint.stem.split("-")[1]) + 1
 
     # `imbalance` describes how the particles are spread over the ranks, which a restart on
     # another rank count changes; every physical column must agree bit for bit.
@@ -121,6 +132,8 @@ def main():
     problems = compare_history(reference, killed, "soak", skip) + compare_snapshots(reference, killed, "soak")
     for p in problems:
         print("problem:", p)
+    if kills == 0:
+        problems.append("no kill landed before the run ended")
     print(f"RESULT: {'PASS' if not problems else 'FAIL'}: {kills} kills and {restarts} restarts, "
           f"{'bit-identical to' if not problems else 'different from'} the uninterrupted run of {steps} steps")
     return 1 if problems else 0

@@ -97,8 +97,14 @@ void StallWatchdog::write_own_file(long long step, double stepped_unix) const {
   fs::rename(tmp, file, ec);
 }
 
+double StallWatchdog::write_period() const {
+  // Once a second, a quarter of the timeout when that is shorter; beyond 100 ranks less often,
+  // so that the files cost a shared file system's metadata server at most ~100 writes a second.
+  return std::clamp(timeout_ / 4.0, 0.05, std::max(1.0, size_ / 100.0));
+}
+
 void StallWatchdog::watch() {
-  const double period = std::clamp(timeout_ / 4.0, 0.05, 1.0);
+  const double period = write_period();
   std::unique_lock lock(mutex_);
   while (!stop_) {
     wake_.wait_for(lock, std::chrono::duration<double>(period));
@@ -122,7 +128,7 @@ void StallWatchdog::watch() {
 
 std::string StallWatchdog::diagnosis(long long step, double waited) const {
   const double now = unix_seconds();
-  const double period = std::clamp(timeout_ / 4.0, 0.05, 1.0);
+  const double period = write_period();
   std::vector<RankBeat> beats(static_cast<std::size_t>(size_));
   std::vector<int> silent, alive;
   for (int r = 0; r < size_; ++r) {

@@ -5,8 +5,8 @@
 // thread notes every completed step; when none has completed for simulation.mpi_timeout seconds
 // it names the rank that stopped answering and ends its own process with exit code 1, which
 // makes the launcher stop the job. To name that rank, each watchdog writes its rank's last
-// step and the wall-clock time of its last beat to <output>/.ranks/rank-R once a second: a
-// stopped rank's file goes stale.
+// step and the wall-clock time of its last beat to <output>/.ranks/rank-R once a second (less
+// often beyond 100 ranks): a stopped rank's file goes stale.
 #pragma once
 
 #include <condition_variable>
@@ -32,6 +32,7 @@ class StallWatchdog {
 
  private:
   void watch();
+  [[nodiscard]] double write_period() const;
   void write_own_file(long long step, double unix_time) const;
   [[nodiscard]] std::string diagnosis(long long step, double waited) const;
 
