@@ -259,7 +259,8 @@ TEST(InputErrors, UnknownMaterialModel) {
 TEST(InputErrors, BodyShapeOfUnknownKind) {
   EXPECT_EQ(message(error_of(with("{ box = { min", "{ cube = { min"))),
             "case.toml:26: key 'body[0].shape.cube': expected a shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere, cylinder, image, mesh, volume_mesh, outline, points; found \"cube\"");
+            "ellipse, annulus, polygon, sphere, cylinder, image, mesh, volume_mesh, outline, points, "
+            "image_stack; found \"cube\"");
   EXPECT_EQ(message(error_of(with("shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] } }",
                                   "shape = { sphere = { center = [0.03, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape.sphere': expected a shape kind valid in 2D, one of box, "
@@ -268,8 +269,8 @@ TEST(InputErrors, BodyShapeOfUnknownKind) {
                                   "shape = { box = { min = [0.01, 0.01], max = [0.06, 0.03] }, "
                                   "circle = { center = [0.1, 0.02], radius = 0.01 } }"))),
             "case.toml:26: key 'body[0].shape': expected exactly one shape kind, one of box, circle, "
-            "ellipse, annulus, polygon, sphere, cylinder, image, mesh, volume_mesh, outline, points; found 2 kinds: box, "
-            "circle");
+            "ellipse, annulus, polygon, sphere, cylinder, image, mesh, volume_mesh, outline, points, "
+            "image_stack; found 2 kinds: box, circle");
 }
 
 TEST(InputErrors, BodyShapeMissingItsParameters) {

@@ -195,7 +195,9 @@ TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
   create_particles<2>(c, grid, materials, Mode::plane_strain, all);
   ASSERT_GT(all.n(), 100u);
   std::vector<std::int64_t> seen;
-  const ParticleSelection<2> select = [&](std::int64_t id, std::int32_t body, const Vec<2>& X, const Vec<2>& x) {
+  const ParticleSelection<2> select = [&](std::int64_t id, std::int32_t body, const Vec<2>& X, const Vec<2>& x,
+                                         bool replicated) {
+    EXPECT_TRUE(replicated);  // (one rank: every body generated whole)
     seen.push_back(id);
     const auto p = static_cast<std::size_t>(id);
     EXPECT_EQ(body, all.body[p]);
@@ -223,7 +225,9 @@ TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
   // An overlap is found the same way when the overlapping particles are not stored.
   c.bodies[1].shape.min = {0.6, 0.1};
   Particles<2> none;
-  const ParticleSelection<2> nothing = [](std::int64_t, std::int32_t, const Vec<2>&, const Vec<2>&) { return false; };
+  const ParticleSelection<2> nothing = [](std::int64_t, std::int32_t, const Vec<2>&, const Vec<2>&, bool) {
+    return false;
+  };
   EXPECT_THROW(create_particles<2>(c, grid, materials, Mode::plane_strain, none, &nothing), InputError);
   EXPECT_EQ(none.n(), 0u);
 }

@@ -86,14 +86,14 @@ struct MaterialConfig {
   [[nodiscard]] double number(const std::string& key) const { return numbers.at(key); }
 };
 
-struct GreyImage;  // io/image.hpp
+struct GreyImage;  // geometry/image.hpp
 namespace geometry {
 class SurfaceMesh;  // geometry/surface_mesh.hpp
 struct PointSet;    // geometry/point_set.hpp
 }  // namespace geometry
 
 struct BodyShapeConfig {
-  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | cylinder | image | mesh | volume_mesh | points | outline
+  std::string kind;  ///< box | circle | ellipse | annulus | polygon | sphere | cylinder | image | image_stack | mesh | volume_mesh | points | outline
   std::vector<double> min, max;         ///< box
   std::vector<double> center;           ///< circle, ellipse, annulus, sphere, cylinder
   double radius = 0.0;                  ///< circle, sphere, cylinder
@@ -108,8 +108,14 @@ struct BodyShapeConfig {
   double pixel_size = 0.0;
   std::vector<double> origin;
   int level_min = 0, level_max = 255;
-  /// image: the pixels, read once by the loader and shared by bodies naming the same file;
-  /// null when the Config was built in code (bodies.cpp then reads `file`).
+  /// image_stack (3D): `file` is the folder of the slices, `pattern` the glob their names match
+  /// (geometry/image.hpp); slice k (in the order of the numbers in the names) covers
+  /// z in [origin_z + k slice_spacing, origin_z + (k + 1) slice_spacing).
+  std::string pattern;
+  double slice_spacing = 0.0;
+  /// image, image_stack: the pixels (voxels), read once by the loader and shared by bodies naming
+  /// the same file (folder and pattern); null when the Config was built in code (bodies.cpp then
+  /// reads `file`).
   std::shared_ptr<const GreyImage> image;
   /// mesh (3D): a closed triangle surface (STL, OBJ, PLY, OFF) in `file`, placed by x = R (s x_file) + t
   /// with s = scale times the file's unit in the model's length unit, R the rotation by the Euler
@@ -123,8 +129,10 @@ struct BodyShapeConfig {
   /// loader from a Gmsh mesh (`quadrature` points per element) or a CSV/HDF5 point file.
   int quadrature = 1;
   std::shared_ptr<const geometry::PointSet> points;
-  /// outline (2D): closed loops, the first the outside and the others holes (even-odd rule), from a file.
+  /// outline (2D): closed loops, the first the outside and the others holes (even-odd rule), from a
+  /// CSV file, or the cut of the plane z = slice_z through a surface mesh file.
   std::vector<std::vector<std::vector<double>>> loops;
+  double slice_z = 0.0;
 };
 
 struct BodyConfig {

@@ -4,6 +4,8 @@
 // skips no C++ destructor.
 #include "cairn/geometry/image.hpp"
 
+#include <fmt/format.h>
+#include <fnmatch.h>
 #include <png.h>
 
 #include <cerrno>
@@ -11,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 
 namespace cairn {
@@ -119,6 +122,60 @@ GreyImage read_png_grey(const std::string& path) {
   std::fclose(fp);
   if (!ok) throw fail(state.message);
   return image;
+}
+
+GreyImage read_png_stack(const std::string& folder, const std::string& pattern) {
+  namespace fs = std::filesystem;
+  auto fail = [&](const std::string& why) {
+    return std::invalid_argument("image stack '" + folder + "': " + why);
+  };
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw fail("not a folder");
+  // The slices by number: the last run of digits in each matching name.
+  std::map<long long, std::string> by_number;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_regular_file() || fnmatch(pattern.c_str(), name.c_str(), 0) != 0) continue;
+    const std::size_t last = name.find_last_of("0123456789");
+    if (last == std::string::npos)
+      throw fail(fmt::format("'{}' has no slice number (slices are ordered by the last number in their names)",
+                             name));
+    const std::size_t first = name.find_last_not_of("0123456789", last) + 1;  // npos + 1 = 0
+    if (last - first >= 15) throw fail(fmt::format("'{}': slice number of more than 15 digits", name));
+    const long long number = std::stoll(name.substr(first, last - first + 1));
+    const auto [at, fresh] = by_number.emplace(number, name);
+    if (!fresh) throw fail(fmt::format("'{}' and '{}' have the same slice number {}", at->second, name, number));
+  }
+  if (ec) throw fail("cannot list it: " + ec.message());
+  if (by_number.empty()) throw fail(fmt::format("no file matches '{}' (an empty folder?)", pattern));
+  for (auto it = std::next(by_number.begin()); it != by_number.end(); ++it) {
+    const auto before = std::prev(it);
+    if (it->first != before->first + 1)
+      throw fail(fmt::format("slice {} is missing: the numbers jump from '{}' to '{}'", before->first + 1,
+                             before->second, it->second));
+  }
+  GreyImage stack;
+  stack.depth = static_cast<int>(by_number.size());
+  for (const auto& [number, name] : by_number) {
+    const std::string path = (fs::path(folder) / name).string();
+    GreyImage slice = read_png_grey(path);
+    if (stack.files.empty()) {
+      stack.width = slice.width;
+      stack.height = slice.height;
+      const double voxels = static_cast<double>(slice.width) * slice.height * stack.depth;
+      if (voxels > static_cast<double>(max_stack_voxels))
+        throw fail(fmt::format("{} slices of {} x {} pixels, more than the {} voxels a stack may have", stack.depth,
+                               slice.width, slice.height, max_stack_voxels));
+      stack.level.reserve(static_cast<std::size_t>(voxels));
+    } else if (slice.width != stack.width || slice.height != stack.height) {
+      throw fail(fmt::format("slice '{}' is {} x {} pixels, the first slice '{}' {} x {}", name, slice.width,
+                             slice.height, fs::path(stack.files.front()).filename().string(), stack.width,
+                             stack.height));
+    }
+    stack.level.insert(stack.level.end(), slice.level.begin(), slice.level.end());
+    stack.files.push_back(path);
+  }
+  return stack;
 }
 
 std::string resolve_input_relative(const std::string& file, const std::string& input_file) {

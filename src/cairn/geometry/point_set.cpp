@@ -75,6 +75,14 @@ std::shared_ptr<const PointSet> read_point_h5(const std::string& path, int dimen
     const std::vector<double> position = read("position", d), volume = read("volume", 0);
     const std::vector<double> velocity = has("velocity") ? read("velocity", d) : std::vector<double>{};
     const std::vector<double> temperature = has("temperature") ? read("temperature", 0) : std::vector<double>{};
+    const std::size_t n_stress = d == 3 ? 6 : 3;  // Voigt xx, yy, zz, yz, xz, xy; 2D xx, yy, xy
+    if (has("stress")) {
+      const auto s_shape = h5::dataset_shape(root, "stress");
+      if (s_shape.size() != 2 || s_shape[0] != n || s_shape[1] != n_stress)
+        fail(fmt::format("dataset 'stress' of shape [{}], not {} x {} ({})", fmt::join(s_shape, ", "), n, n_stress,
+                         d == 3 ? "xx, yy, zz, yz, xz, xy" : "xx, yy, xy"));
+    }
+    const std::vector<double> stress = has("stress") ? read("stress", n_stress) : std::vector<double>{};
     for (std::size_t i = 0; i < n; ++i) {
       std::array<double, 3> x{0.0, 0.0, 0.0};
       for (std::size_t a = 0; a < d; ++a) x[a] = position[i * d + a];
@@ -89,6 +97,11 @@ std::shared_ptr<const PointSet> read_point_h5(const std::string& path, int dimen
         set->velocity.push_back(v);
       }
       if (!temperature.empty()) set->temperature.push_back(temperature[i]);
+      if (!stress.empty()) {
+        const double* t = &stress[i * n_stress];
+        set->stress.push_back(d == 3 ? std::array<double, 6>{t[0], t[1], t[2], t[3], t[4], t[5]}
+                                     : std::array<double, 6>{t[0], t[1], 0.0, 0.0, 0.0, t[2]});
+      }
     }
   } catch (const std::runtime_error& e) {  // HDF5 failures (h5:: helpers)
     fail(e.what());
@@ -111,6 +124,11 @@ std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dime
   allowed.push_back("volume");
   for (int a = 0; a < dimension; ++a) allowed.push_back("v" + axes[static_cast<std::size_t>(a)]);
   allowed.push_back("temperature");
+  // Initial stress, in Voigt order (xx, yy, zz, yz, xz, xy); 2D: xx, yy, xy.
+  const std::vector<std::string> stress_names =
+      dimension == 3 ? std::vector<std::string>{"sxx", "syy", "szz", "syz", "sxz", "sxy"}
+                     : std::vector<std::string>{"sxx", "syy", "sxy"};
+  allowed.insert(allowed.end(), stress_names.begin(), stress_names.end());
   std::map<std::string, std::size_t> column;
   std::size_t n_columns = 0;
   std::string line;
@@ -137,6 +155,11 @@ std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dime
       for (int a = 0; a < dimension; ++a) velocities += column.count("v" + axes[static_cast<std::size_t>(a)]) ? 1 : 0;
       if (velocities != 0 && velocities != dimension)
         fail(number, fmt::format("{} of the {} velocity columns (all or none)", velocities, dimension));
+      std::size_t stresses = 0;
+      for (const auto& name : stress_names) stresses += column.count(name);
+      if (stresses != 0 && stresses != stress_names.size())
+        fail(number, fmt::format("{} of the {} stress columns {} (all or none)", stresses, stress_names.size(),
+                                 fmt::join(stress_names, ", ")));
       n_columns = f.size();
       continue;
     }
@@ -163,6 +186,13 @@ std::shared_ptr<const PointSet> read_point_csv(const std::string& path, int dime
       set->velocity.push_back(v);
     }
     if (column.count("temperature")) set->temperature.push_back(value("temperature"));
+    if (column.count("sxx")) {
+      std::array<double, 6> t{0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+      const std::array<std::size_t, 6> slot{0, 1, 2, 3, 4, 5}, planar{0, 1, 5, 0, 0, 0};
+      for (std::size_t i = 0; i < stress_names.size(); ++i)
+        t[dimension == 3 ? slot[i] : planar[i]] = value(stress_names[i]);
+      set->stress.push_back(t);
+    }
   }
   if (column.empty()) fail(0, "no header row (an empty file?)");
   if (set->position.empty()) fail(0, "a header but no particle rows");

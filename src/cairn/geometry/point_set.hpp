@@ -4,13 +4,16 @@
 // mass = density x volume.
 //
 // The HDF5 file (.h5, .hdf5): double datasets `position` (n x D), `volume` (n), optional
-// `velocity` (n x D) and `temperature` (n) at its root.
+// `velocity` (n x D), `temperature` (n) and `stress` (n x 6 in 3D: xx, yy, zz, yz, xz, xy;
+// n x 3 in 2D: xx, yy, xy) at its root.
 //
 // The CSV file: a header row naming the columns, then one row per particle, fields separated by
 // commas; blank lines and lines starting with '#' are skipped. Columns: x, y (2D, 3D), z (3D),
 // volume (required; in 2D an area, multiplied by simulation.thickness), vx, vy, vz (optional,
-// all or none; they replace the body's `velocity`), temperature (optional). Other columns are an
-// error (a misspelt name would otherwise be dropped).
+// all or none; they replace the body's `velocity`), temperature (optional), and the initial
+// Cauchy stress (optional, all or none, tension positive, in the model's stress unit): sxx, syy,
+// szz, syz, sxz, sxy in 3D, sxx, syy, sxy in 2D. Other columns are an error (a misspelt name
+// would otherwise be dropped).
 #pragma once
 
 #include <array>
@@ -28,6 +31,8 @@ struct PointSet {
   std::vector<double> volume;                   ///< > 0 each
   std::vector<std::array<double, 3>> velocity;  ///< empty = not given
   std::vector<double> temperature;              ///< empty = not given
+  /// Initial Cauchy stress, Voigt order xx, yy, zz, yz, xz, xy (2D: zz, yz, xz zero); empty = not given.
+  std::vector<std::array<double, 6>> stress;
   std::array<double, 3> lo{}, hi{};             ///< bounds of the positions
   double total_volume = 0.0;
   [[nodiscard]] std::size_t n() const { return position.size(); }

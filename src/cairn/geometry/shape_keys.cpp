@@ -16,11 +16,14 @@ const std::vector<ShapeKindDecl>& shape_kinds() {
        "Elements of a Gmsh mesh (.msh, or .geo meshed on reading): 3-node triangles (2D) or 4-node "
        "tetrahedra (3D), one particle per element or per quadrature point (docs/geometry.md)."},
       {"outline", {false, true, false},
-       "Inside of closed loops read from a CSV file, the first the outside and the others holes "
-       "(docs/geometry.md)."},
+       "Inside of closed loops read from a CSV file, the first the outside and the others holes, or "
+       "of the cut of a closed surface mesh at z = slice_z (docs/geometry.md)."},
       {"points", {false, true, true},
-       "Particles given one by one in a CSV or HDF5 file: position, volume, optional velocity and "
-       "temperature (docs/geometry.md)."},
+       "Particles given one by one in a CSV or HDF5 file: position, volume, optional velocity, "
+       "temperature and initial stress (docs/geometry.md)."},
+      {"image_stack", {false, false, true},
+       "Voxels of a stack of grey-level PNG slices (a CT scan) whose level lies in a range, one body per "
+       "material shade, as `image` in 2D (docs/geometry.md)."},
   };
   return kinds;
 }
@@ -71,17 +74,46 @@ std::vector<KeyDecl> shape_keys() {
   const std::size_t n_outline = k.size();
   k.push_back(key("file", KeyType::string, "",
                   "CSV file of vertices \"x, y\", one per line, loops separated by blank lines: the first "
-                  "loop the outside, the others holes; relative to the input file's directory."));
+                  "loop the outside, the others holes; or a closed surface mesh (.stl, .obj, .ply, .off) cut by "
+                  "the plane z = slice_z. Relative to the input file's directory."));
   k.push_back(key("scale", KeyType::real, "1.0", "Factor on the file's coordinates."));
   k.back().min = std::numeric_limits<double>::denorm_min();
   k.push_back(key("translate", KeyType::real_array, "[0.0, 0.0]", "Shift [x, y] applied after scale."));
+  k.push_back(key("slice_z", KeyType::real, "0.0",
+                  "A surface mesh file: the height z (of the scaled coordinates) of the plane whose cut through "
+                  "the surface is the outline; its closed curves are the loops (even-odd rule)."));
   for (std::size_t i = n_outline; i < k.size(); ++i) k[i].section = "body.shape.outline";
   KeyDecl points = key("file", KeyType::string, "",
-                        "CSV file with a header row x, y (, z), volume (an area in 2D), optional vx, vy (, vz) and "
-                        "temperature, one particle per row; or HDF5 (.h5, .hdf5) with datasets position (n x D), "
-                        "volume (n), optional velocity, temperature. Relative to the input file's directory.");
+                        "CSV file with a header row x, y (, z), volume (an area in 2D), optional vx, vy (, vz), "
+                        "temperature and initial stress (sxx, syy, szz, syz, sxz, sxy in 3D; sxx, syy, sxy in 2D), one "
+                        "particle per row; or HDF5 (.h5, .hdf5) with datasets position (n x D), volume (n), optional "
+                        "velocity, temperature, stress (n x 6 / n x 3). Relative to the input file's directory.");
   points.section = "body.shape.points";
   k.push_back(points);
+  // image_stack: the slices, their placement and the grey levels of the body.
+  const std::size_t n_stack = k.size();
+  k.push_back(key("folder", KeyType::string, "",
+                  "Folder of the slices (PNG files, any kind as for `image`), relative to the directory of the "
+                  "input file; slice 0, at the lowest z, is the file with the lowest number in its name, the "
+                  "numbers consecutive."));
+  k.push_back(key("pattern", KeyType::string, "\"*.png\"",
+                  "Glob (fnmatch: *, ?, [...]) that the slices' file names match, e.g. \"ct_*.png\"; other files "
+                  "in the folder are not read."));
+  k.push_back(key("pixel_size", KeyType::real, "", "Edge of one (square) pixel of a slice in length units."));
+  k.back().min = std::numeric_limits<double>::denorm_min();
+  k.push_back(key("slice_spacing", KeyType::real, "",
+                  "Distance between slices along z in length units: slice k covers z in [z0 + k slice_spacing, "
+                  "z0 + (k + 1) slice_spacing)."));
+  k.back().min = std::numeric_limits<double>::denorm_min();
+  k.push_back(key("origin", KeyType::real_array, "[0.0, 0.0, 0.0]",
+                  "Position [x0, y0, z0] of the lower-left corner of slice 0: each slice covers width * "
+                  "pixel_size by height * pixel_size from there, its first (top) row at the highest y."));
+  k.push_back(key("levels", KeyType::integer_array, "",
+                  "Grey levels [lo, hi] (0 = black, 255 = white), lo <= hi: a particle position belongs to the "
+                  "body when the voxel under it has a level in lo..hi."));
+  k.back().min = 0;
+  k.back().max = 255;
+  for (std::size_t i = n_stack; i < k.size(); ++i) k[i].section = "body.shape.image_stack";
   return k;
 }
 

@@ -17,7 +17,7 @@ struct ShapeKindDecl {
 };
 
 /// The shape kinds read from files: mesh (3D surface meshes), volume_mesh (Gmsh elements),
-/// outline (2D loops with holes), points (CSV point files).
+/// outline (2D loops with holes), points (CSV/HDF5 point files), image_stack (3D PNG slices).
 const std::vector<ShapeKindDecl>& shape_kinds();
 
 /// Their parameters, as key declarations of sections "body.shape.<kind>".

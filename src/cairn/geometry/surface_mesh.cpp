@@ -16,6 +16,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
+#include <CGAL/Polygon_mesh_slicer.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <fmt/format.h>
@@ -299,6 +300,23 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
   out.tree_bytes_ = grown > heap ? grown - heap : 0;
   out.impl_->side = std::make_unique<Side>(tree);
   return result;
+}
+
+SurfaceMesh::Cut SurfaceMesh::slice(double z) const {
+  CGAL::Polygon_mesh_slicer<Mesh, Kernel> slicer(impl_->mesh);  // (its own AABB tree, of the edges)
+  std::vector<std::vector<Point>> polylines;
+  slicer(Kernel::Plane_3(0.0, 0.0, 1.0, -z), std::back_inserter(polylines));
+  Cut cut;
+  for (const auto& line : polylines) {
+    if (line.size() < 2 || line.front() != line.back()) {
+      ++cut.open;
+      continue;
+    }
+    std::vector<std::array<double, 2>> loop;
+    for (std::size_t i = 0; i + 1 < line.size(); ++i) loop.push_back({line[i].x(), line[i].y()});
+    cut.loops.push_back(std::move(loop));
+  }
+  return cut;
 }
 
 std::string volume_note(const std::string& body, const SurfaceMesh& mesh, long long n_particles,

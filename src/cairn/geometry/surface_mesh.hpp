@@ -73,6 +73,14 @@ class SurfaceMesh {
   [[nodiscard]] std::size_t tree_bytes() const { return tree_bytes_; }
   /// Repairs made while reading (an orientation turned outward), one sentence each.
   [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
+  /// The cut of the plane z = `z` through the surface (CGAL::Polygon_mesh_slicer): its polylines
+  /// as [x, y] vertices, each closed one without its repeated last vertex; `open` counts the
+  /// polylines that do not close (the plane runs along a face or an edge).
+  struct Cut {
+    std::vector<std::vector<std::array<double, 2>>> loops;
+    std::size_t open = 0;
+  };
+  [[nodiscard]] Cut slice(double z) const;
 
   friend std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path,
                                                                const MeshPlacement& placement);

@@ -450,19 +450,24 @@ class Loader {
   void read_mesh_shape(TableReader& r, BodyShapeConfig& s, const std::vector<BodyConfig>& earlier);
   /// file, units, scale, rotate, translate of a mesh shape (into `s`) as a placement.
   geometry::MeshPlacement read_placement(TableReader& r, BodyShapeConfig& s);
-  /// The `file` key of a shape read from a file: non-empty, resolved against the input's folder.
-  std::string file_key(TableReader& r) {
-    const std::string file = r.string("file");
-    if (file.empty()) r.fail("file", r.given("file"), "a non-empty file name", "\"\"");
+  /// shape = { image = {...} } (2D) or { image_stack = {...} } (3D): the placement, the levels and
+  /// the picture or slices (geometry/image.hpp), read once per file (folder and pattern).
+  void read_image_shape(TableReader& r, BodyShapeConfig& s, const std::vector<BodyConfig>& earlier);
+  /// The `key` (`file`, `folder`) of a shape read from a file: non-empty, resolved against the
+  /// input's folder.
+  std::string file_key(TableReader& r, const std::string& key = "file") {
+    const std::string file = r.string(key);
+    if (file.empty()) r.fail(key, r.given(key), "a non-empty " + key + " name", "\"\"");
     return resolve_input_relative(file, file_);
   }
-  /// What `read` returns, its std::invalid_argument an input error at the `file` key.
+  /// What `read` returns, its std::invalid_argument an input error at `key` (the `file` key).
   template <class Read>
-  auto read_file_key(TableReader& r, const std::string& expected, Read&& read) -> decltype(read()) {
+  auto read_file_key(TableReader& r, const std::string& expected, Read&& read, const std::string& key = "file")
+      -> decltype(read()) {
     try {
       return read();
     } catch (const std::invalid_argument& e) {
-      r.fail("file", r.given("file"), expected + ", relative to the input file's directory", e.what());
+      r.fail(key, r.given(key), expected + ", relative to the input file's directory", e.what());
     }
   }
   void read_boundary(const toml::table& root, Config& cfg);

@@ -98,6 +98,8 @@ const std::map<std::string, std::string>& type_overrides() {
       {"body.shape.polygon.vertices", "real[2][n]"},
       {"body.shape.image.origin", "real[2]"},
       {"body.shape.image.levels", "integer[2]"},
+      {"body.shape.image_stack.origin", "real[3]"},
+      {"body.shape.image_stack.levels", "integer[2]"},
       {"body.shape.mesh.rotate", "real[3]"},
       {"body.shape.mesh.translate", "real[3]"},
       {"body.shape.outline.translate", "real[2]"},

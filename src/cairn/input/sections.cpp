@@ -295,53 +295,67 @@ BodyShapeConfig Loader::read_shape(TableReader& body, const std::vector<BodyConf
     }
     if (twice_area == 0.0)
       r.fail("vertices", r.given("vertices"), "vertices enclosing a non-zero area", "zero area");
-  } else if (kind == "image") {
-    const std::string file = r.string("file");
-    if (file.empty()) r.fail("file", r.given("file"), "a non-empty PNG file name", "\"\"");
-    s.file = resolve_input_relative(file, file_);
-    s.pixel_size = r.real("pixel_size");
-    s.origin = r.reals("origin", 2, false);
-    const std::string levels = "an array of 2 integers [lo, hi], each in 0..255";
-    if (const toml::node* lv = r.given("levels")) {
-      const toml::array* a = lv->as_array();
-      if (!a) r.fail("levels", lv, levels, typed_text(*lv));
-      if (a->size() != 2) r.fail("levels", lv, levels, fmt::format("{} ({} entries)", node_text(*lv), a->size()));
-    }
-    const std::vector<int> lh = r.integers("levels", 2, false);
-    s.level_min = lh[0];
-    s.level_max = lh[1];
-    if (s.level_min > s.level_max)
-      r.fail("levels", r.given("levels"), "levels [lo, hi] with lo <= hi",
-             fmt::format("lo = {} > hi = {}", s.level_min, s.level_max));
-    for (const auto& other : earlier)
-      if (other.shape.image && other.shape.file == s.file) s.image = other.shape.image;
-    if (!s.image) {
-      try {
-        s.image = std::make_shared<const GreyImage>(read_png_grey(s.file));
-      } catch (const std::invalid_argument& e) {
-        r.fail("file", r.given("file"), "a readable PNG file (relative to the input file's directory)",
-               e.what());
-      }
-    }
+  } else if (kind == "image" || kind == "image_stack") {
+    read_image_shape(r, s, earlier);
   } else if (kind == "mesh" || kind == "volume_mesh") {
     read_mesh_shape(r, s, earlier);
   } else if (kind == "outline") {
     s.file = file_key(r);
     s.scale = r.real("scale");
     s.translate = r.reals("translate", 2, false);
+    s.slice_z = r.real("slice_z");
     s.loops = read_file_key(r, "a CSV outline: lines \"x, y\", loops separated by blank lines, the first the "
-                               "outside and the others holes inside it, no two edges meeting (docs/geometry.md)",
-                            [&] { return geometry::read_outline_csv(s.file, s.scale, s.translate); });
+                               "outside and the others holes inside it, no two edges meeting; or a closed surface "
+                               "mesh that the plane z = slice_z cuts in closed curves (docs/geometry.md)",
+                            [&] { return geometry::read_outline(s.file, s.scale, s.translate, s.slice_z); });
   } else if (kind == "points") {
     s.file = file_key(r);
-    s.points = read_file_key(r, "a point file: CSV with a header row x, y(, z), volume[, vx, vy(, vz)][, temperature] "
-                                "and one row per particle, or HDF5 (.h5) with datasets position, volume[, velocity]"
-                                "[, temperature] (docs/geometry.md)",
+    s.points = read_file_key(r, "a point file: CSV with a header row x, y(, z), volume[, vx, vy(, vz)][, temperature]"
+                                "[, stress columns sxx, ...] and one row per particle, or HDF5 (.h5) with datasets "
+                                "position, volume[, velocity][, temperature][, stress] (docs/geometry.md)",
                              [&] { return geometry::read_point_file(s.file, dim_); });
   } else {
     throw std::logic_error("input: shape kind '" + kind + "' declared but not read");
   }
   return s;
+}
+
+void Loader::read_image_shape(TableReader& r, BodyShapeConfig& s, const std::vector<BodyConfig>& earlier) {
+  const bool stack = s.kind == "image_stack";
+  const std::string key = stack ? "folder" : "file";
+  s.file = file_key(r, key);
+  s.pixel_size = r.real("pixel_size");
+  if (stack) {
+    s.slice_spacing = r.real("slice_spacing");
+    s.pattern = r.string("pattern");
+    if (s.pattern.empty()) r.fail("pattern", r.given("pattern"), "a non-empty glob such as \"*.png\"", "\"\"");
+  }
+  s.origin = r.reals("origin", stack ? 3 : 2, false);
+  const std::string levels = "an array of 2 integers [lo, hi], each in 0..255";
+  if (const toml::node* lv = r.given("levels")) {
+    const toml::array* a = lv->as_array();
+    if (!a) r.fail("levels", lv, levels, typed_text(*lv));
+    if (a->size() != 2) r.fail("levels", lv, levels, fmt::format("{} ({} entries)", node_text(*lv), a->size()));
+  }
+  const std::vector<int> lh = r.integers("levels", 2, false);
+  s.level_min = lh[0];
+  s.level_max = lh[1];
+  if (s.level_min > s.level_max)
+    r.fail("levels", r.given("levels"), "levels [lo, hi] with lo <= hi",
+           fmt::format("lo = {} > hi = {}", s.level_min, s.level_max));
+  for (const auto& other : earlier)
+    if (other.shape.image && other.shape.kind == s.kind && other.shape.file == s.file &&
+        other.shape.pattern == s.pattern)
+      s.image = other.shape.image;
+  if (s.image) return;
+  s.image = read_file_key(
+      r,
+      stack ? "a folder of PNG slices numbered consecutively, all of one size (docs/geometry.md)"
+            : "a readable PNG file",
+      [&] {
+        return std::make_shared<const GreyImage>(stack ? read_png_stack(s.file, s.pattern) : read_png_grey(s.file));
+      },
+      key);
 }
 
 geometry::MeshPlacement Loader::read_placement(TableReader& r, BodyShapeConfig& s) {

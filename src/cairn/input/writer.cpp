@@ -44,9 +44,13 @@ std::string shape_text(const BodyShapeConfig& s) {
   else if (s.kind == "image")
     params = fmt::format("file = {}, pixel_size = {}, origin = {}, levels = [{}, {}]", toml_string(s.file),
                          real_text(s.pixel_size), reals_text(s.origin), s.level_min, s.level_max);
+  else if (s.kind == "image_stack")
+    params = fmt::format("folder = {}, pattern = {}, pixel_size = {}, slice_spacing = {}, origin = {}, levels = [{}, {}]",
+                         toml_string(s.file), toml_string(s.pattern), real_text(s.pixel_size),
+                         real_text(s.slice_spacing), reals_text(s.origin), s.level_min, s.level_max);
   else if (s.kind == "outline")
-    params = fmt::format("file = {}, scale = {}, translate = {}", toml_string(s.file), real_text(s.scale),
-                         reals_text(s.translate));
+    params = fmt::format("file = {}, scale = {}, translate = {}, slice_z = {}", toml_string(s.file),
+                         real_text(s.scale), reals_text(s.translate), real_text(s.slice_z));
   else if (s.kind == "points")
     params = fmt::format("file = {}", toml_string(s.file));
   else if (s.kind == "mesh" || s.kind == "volume_mesh")

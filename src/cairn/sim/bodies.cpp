@@ -14,14 +14,17 @@
 // [oy + (H - 1 - row) s, oy + (H - row) s), so row 0 (the top of the picture) lies at the
 // highest y; positions outside the picture are outside the body. A position on a pixel edge
 // (to 1e-6 pixel, so that rounding does not decide) belongs to the pixel on its +x / +y side:
-// lattices whose points fall on pixel corners sample the picture consistently.
+// lattices whose points fall on pixel corners sample the picture consistently. An image_stack
+// (3D) does the same in each slice, slice k covering [oz + k dz, oz + (k + 1) dz) along z with
+// dz = slice_spacing (seed 004 Sec. 4.2 extended from one picture to a stack).
 //
 // Shapes from files (docs/geometry.md): a mesh (3D) keeps X when X is inside its closed surface
 // (geometry/surface_mesh.hpp; the lattice is visited line by line along x, which is what the
 // surface's per-line memo is for); an outline (2D) by the even-odd rule over its loops, as a
 // polygon; volume_mesh and points replace the lattice by their own particles (geometry/
 // volume_mesh.hpp, point_set.hpp), each with its own volume and a domain of a square/cube of that
-// volume, a point file's velocities and temperatures replacing the body's.
+// volume, a point file's velocities and temperatures replacing the body's, and its stresses
+// giving each particle the stretch that carries them (materials/initial_stress.hpp).
 //
 // Only the lattice points inside the shape's bounds are visited (sim/resources.hpp), in the same
 // order as a sweep of the whole grid would visit them. A shape reaching past the grid is an error
@@ -30,10 +33,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "cairn/bc/expression.hpp"
 #include "cairn/geometry/outline.hpp"
@@ -41,6 +47,7 @@
 #include "cairn/geometry/surface_mesh.hpp"
 #include "cairn/config/errors.hpp"
 #include "cairn/geometry/image.hpp"
+#include "cairn/materials/initial_stress.hpp"
 #include "cairn/parallel/comm.hpp"
 #include "cairn/sim/resources.hpp"
 #include "cairn/sim/simulation.hpp"
@@ -86,8 +93,8 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, geometry::LineCach
   if (s.kind == "mesh" && s.mesh) {
     if constexpr (D == 3) return s.mesh->inside(x[0], x[1], x[2], line);
   }
-  if (s.kind == "image" && image) {
-    if constexpr (D == 2) {
+  if ((s.kind == "image" || s.kind == "image_stack") && image) {
+    if constexpr (D >= 2) {
       const Vec<D> o = vec(s.origin);
       auto pixel = [&](double t) {
         const double r = std::round(t);
@@ -96,7 +103,13 @@ bool inside(const BodyShapeConfig& s, const GreyImage* image, geometry::LineCach
       const double u = pixel((x[0] - o[0]) / s.pixel_size);
       const double v = pixel((x[1] - o[1]) / s.pixel_size);
       if (!(u >= 0.0 && u < image->width && v >= 0.0 && v < image->height)) return false;
-      const int level = image->at(static_cast<int>(u), image->height - 1 - static_cast<int>(v));
+      int slice = 0;
+      if constexpr (D == 3) {
+        const double w = pixel((x[2] - o[2]) / s.slice_spacing);
+        if (!(w >= 0.0 && w < image->depth)) return false;
+        slice = static_cast<int>(w);
+      }
+      const int level = image->at(static_cast<int>(u), image->height - 1 - static_cast<int>(v), slice);
       return level >= s.level_min && level <= s.level_max;
     }
   }
@@ -135,7 +148,8 @@ inline void check_overlaps(const Config& config, const std::vector<std::vector<s
 template <int D>
 void create_particles(const Config& config, const Grid<D>& grid,
                       const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
-                      Particles<D>& particles, const ParticleSelection<D>* select) {
+                      Particles<D>& particles, const ParticleSelection<D>* select,
+                      const GenerationShare<D>* share) {
   const double thickness = D == 3 ? 1.0 : config.simulation.thickness;
   const std::size_t n_bodies = config.bodies.size();
   // Over every generated particle, stored or not (per-rank generation stores a subset).
@@ -204,6 +218,20 @@ void create_particles(const Config& config, const Grid<D>& grid,
     // A point file: its rows are the particles, with their own volumes (geometry/point_set.hpp).
     const geometry::PointSet* points = body.shape.points.get();  // (points, volume_mesh)
     const bool surface = config.method.integration == "wls" && !points;
+    // A point file's initial stresses: each particle starts at the stretch that carries its
+    // stress (materials/initial_stress.hpp), which only a model whose stress is tau(F) can take.
+    const bool stressed = points && !points->stress.empty();
+    if (stressed && !takes_initial_stress(*materials[mat]))
+      throw InputError(body.where.file, body.where.line, fmt::format("body[{}].shape.points.file", b),
+                       "a material whose stress follows from the deformation alone (linear_elastic, neo_hookean) "
+                       "for a point file with stress columns",
+                       fmt::format("material '{}' (model {}), which keeps its stress in state variables and "
+                                   "cannot start from a given stress",
+                                   body.material, config.materials[static_cast<std::size_t>(mat)].model));
+    if (stressed && displacement)
+      throw InputError(body.where.file, body.where.line, fmt::format("body[{}].displacement", b),
+                       "no displacement on a body whose point file gives initial stresses (the stress sets F)",
+                       "a displacement");
     std::vector<wls::Seed<D>> seeds;
     if (points) {
       for (std::size_t i = 0; i < points->n(); ++i) {
@@ -228,34 +256,45 @@ void create_particles(const Config& config, const Grid<D>& grid,
       for (const Vec<D>& X : wls::lattice_surface_points<D>(in, first, lp, count)) seeds.push_back({X, 0.0});
     }
     const long long n_lattice = radial || points ? 0 : total;
-    for (long long k = 0; k < n_lattice + static_cast<long long>(seeds.size()); ++k) {
+    auto lattice_point = [&](long long k) {
       Vec<D> X;
-      double particle_volume = vol, particle_mass = mass;
-      if (k < n_lattice) {
-        long long rem = k;
-        for (int a = 0; a < D; ++a) {
-          const long long ia = box.lo[a] + rem % span[a];
-          rem /= span[a];
-          X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
-        }
-        if (!inside<D>(body.shape, image.get(), line_of[b], X)) continue;
-      } else {
-        const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
-        X = s.X;
-        particle_volume = s.measure * thickness;
-        particle_mass = materials[mat]->density() * particle_volume;
+      for (int a = 0; a < D; ++a) {
+        const long long ia = box.lo[a] + k % span[a];
+        k /= span[a];
+        X[a] = grid.origin()[a] + (static_cast<double>(ia) + 0.5) * lp[a];
       }
-      // (zero-volume particles carry no mass: they make no overlap)
+      return X;
+    };
+    // A generated particle counts for the body and for its overlaps with earlier bodies
+    // (zero-volume particles carry no mass: they make no overlap).
+    auto tally = [&](const Vec<D>& X, double particle_volume) {
       if (particle_volume > 0.0)
         for (std::size_t a : near_bodies)
           if (inside<D>(config.bodies[a].shape, image_of[a].get(), line_of[a], X)) ++shared[b][a];
       ++count_of[b];
-      const std::int64_t id = next_id++;
+    };
+    // The particle: stored when `select` keeps it. `k`: its lattice point, or n_lattice + its seed.
+    auto emit = [&](long long k, const Vec<D>& X, std::int64_t id, double particle_volume, double particle_mass,
+                    bool replicated) {
+      const std::size_t row = static_cast<std::size_t>(k - n_lattice);
+      // (solved on every rank for every row, so that a refusal is the same on all of them)
+      std::optional<Mat3> stretch;
+      if (stressed) {
+        SymMat3 sigma0;
+        sigma0.voigt() = points->stress[row];
+        stretch = initial_stretch(*materials[mat], sigma0.full(), D < 3, mode == Mode::plane_stress);
+        if (!stretch)
+          throw InputError(body.where.file, body.where.line, fmt::format("body[{}].shape.points.file", b),
+                           fmt::format("initial stresses that material '{}' can carry (a stretch F0 with "
+                                       "tau(F0) = det(F0) sigma0)",
+                                       body.material),
+                           fmt::format("particle {} of '{}' (xx, yy, zz, yz, xz, xy = {}): no such stretch found",
+                                       row + 1, points->file, fmt::join(points->stress[row], ", ")));
+      }
       const Vec<D> x = displacement ? Vec<D>(X + (*displacement)(X, X, 0.0)) : X;
-      if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x)) continue;
+      if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x, replicated)) return;
       Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
       Vec<D> domain = lp;  // a point file's particle: a cube (square) of its own volume (area)
-      const std::size_t row = static_cast<std::size_t>(k - n_lattice);
       if (points) {
         domain = Vec<D>::Constant(std::pow(points->volume[row], 1.0 / D));
         if (!points->velocity.empty())
@@ -263,16 +302,14 @@ void create_particles(const Config& config, const Grid<D>& grid,
       }
       particles.add(X, v0, particle_mass, particle_volume, domain, mat, static_cast<std::int32_t>(b));
       particles.id.back() = id;
-      {
-        const std::size_t p = particles.n() - 1;
-        if (particles.has_temperature)
-          particles.temperature[p] = points && !points->temperature.empty() ? points->temperature[row]
-                                                                             : materials[mat]->initial_temperature();
-        if (particles.n_state_per_particle > 0)
-          materials[mat]->initialize_state(&particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]);
-      }
+      const std::size_t p = particles.n() - 1;
+      if (particles.has_temperature)
+        particles.temperature[p] = points && !points->temperature.empty() ? points->temperature[row]
+                                                                           : materials[mat]->initial_temperature();
+      if (particles.n_state_per_particle > 0)
+        materials[mat]->initialize_state(&particles.state[p * static_cast<std::size_t>(particles.n_state_per_particle)]);
+      if (stretch) particles.deformation_gradient[p] = *stretch;  // its stress: below, from F
       if (displacement) {
-        const std::size_t p = particles.n() - 1;
         particles.position[p] = x;
         Mat3 F = Mat3::Identity();
         for (int a = 0; a < D; ++a) {
@@ -284,6 +321,95 @@ void create_particles(const Config& config, const Grid<D>& grid,
           F.col(a).template head<D>() += du;
         }
         particles.deformation_gradient[p] = F;
+      }
+    };
+    // Per-rank generation of a plain lattice body (no seeds, no displacement): each rank tests
+    // only its own lattice points (generation_share; docs/parallel.md).
+    const bool plain = !radial && !points && !surface && !displacement;
+    if (share && share->comm && share->comm->parallel() && plain && total > 0) {
+      const Comm& comm = *share->comm;
+      // The inside lattice points this rank tests (k, in sweep order) and their ids.
+      std::vector<long long> mine;
+      std::vector<std::int64_t> id_of;
+      auto test = [&](long long k) {
+        const Vec<D> X = lattice_point(k);
+        if (!inside<D>(body.shape, image.get(), line_of[b], X)) return false;
+        tally(X, vol);
+        mine.push_back(k);
+        return true;
+      };
+      const long long rows = total / span[0];  // lines along x, in sweep order
+      if (!share->decomposition) {
+        // The census: rank r tests the r-th block of whole rows; ids follow the ranks' counts.
+        const auto r = static_cast<long long>(comm.rank()), n = static_cast<long long>(comm.size());
+        for (long long k = rows * r / n * span[0]; k < rows * (r + 1) / n * span[0]; ++k) test(k);
+        const std::int64_t first = next_id + comm.exclusive_prefix(static_cast<std::int64_t>(mine.size()));
+        for (std::size_t j = 0; j < mine.size(); ++j) id_of.push_back(first + static_cast<std::int64_t>(j));
+      } else {
+        // Rank r tests the points in the cells of its box. A row meets several ranks' boxes, in
+        // segments between the boxes' x faces: the counts per (row, segment), summed over the
+        // ranks, in sweep order, give every point its id.
+        const Decomposition<D>& dec = *share->decomposition;
+        std::vector<long long> cuts;  // lattice x indices (from box.lo) where a segment starts
+        for (int q = 0; q < dec.n_boxes(); ++q)
+          for (long long c : {static_cast<long long>(dec.box(q).lo[0]), static_cast<long long>(dec.box(q).hi[0])})
+            cuts.push_back(c * ppc[0] - box.lo[0]);
+        std::sort(cuts.begin(), cuts.end());
+        cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+        const auto n_seg = static_cast<long long>(cuts.size());
+        auto segment = [&](long long i) {
+          return static_cast<long long>(std::upper_bound(cuts.begin(), cuts.end(), i) - cuts.begin()) - 1;
+        };
+        const CellBox<D>& cells = dec.box(comm.rank());
+        std::array<long long, 3> lo{0, 0, 0}, hi{0, 0, 0};  // this rank's points, inclusive, from box.lo
+        for (int a = 0; a < D; ++a) {
+          lo[a] = std::max(box.lo[a], static_cast<long long>(cells.lo[a]) * ppc[a]) - box.lo[a];
+          hi[a] = std::min(box.hi[a], static_cast<long long>(cells.hi[a]) * ppc[a] - 1) - box.lo[a];
+        }
+        std::vector<std::int64_t> count(static_cast<std::size_t>(rows * n_seg), 0);
+        const long long stride2 = D == 3 ? span[std::min(1, D - 1)] : 0;  // rows per z layer
+        if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
+          for (long long i2 = lo[2]; i2 <= hi[2]; ++i2)
+            for (long long i1 = lo[1]; i1 <= hi[1]; ++i1) {
+              const long long row = i1 + stride2 * i2;
+              for (long long i0 = lo[0]; i0 <= hi[0]; ++i0)
+                if (test(i0 + span[0] * row)) ++count[static_cast<std::size_t>(row * n_seg + segment(i0))];
+            }
+        constexpr std::size_t chunk = 1u << 24;
+        for (std::size_t at = 0; at < count.size(); at += chunk)
+          comm.sum(count.data() + at, static_cast<int>(std::min(chunk, count.size() - at)));
+        std::int64_t before = 0;  // count -> the first id offset of each (row, segment)
+        for (auto& c : count) before += std::exchange(c, before);
+        for (long long k : mine) {
+          const long long row = k / span[0];
+          std::int64_t& at = count[static_cast<std::size_t>(row * n_seg + segment(k % span[0]))];
+          id_of.push_back(next_id + at++);
+        }
+      }
+      for (std::size_t j = 0; j < mine.size(); ++j) emit(mine[j], lattice_point(mine[j]), id_of[j], vol, mass, false);
+      // The body's count and overlaps over every rank (each point was tested by one rank).
+      std::vector<std::int64_t> sums(n_bodies + 1, 0);
+      sums[0] = static_cast<std::int64_t>(count_of[b]);
+      for (std::size_t a = 0; a < n_bodies; ++a) sums[a + 1] = static_cast<std::int64_t>(shared[b][a]);
+      comm.sum(sums.data(), static_cast<int>(sums.size()));
+      count_of[b] = static_cast<std::size_t>(sums[0]);
+      for (std::size_t a = 0; a < n_bodies; ++a) shared[b][a] = static_cast<std::size_t>(sums[a + 1]);
+      next_id += sums[0];
+    } else {
+      for (long long k = 0; k < n_lattice + static_cast<long long>(seeds.size()); ++k) {
+        Vec<D> X;
+        double particle_volume = vol, particle_mass = mass;
+        if (k < n_lattice) {
+          X = lattice_point(k);
+          if (!inside<D>(body.shape, image.get(), line_of[b], X)) continue;
+        } else {
+          const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
+          X = s.X;
+          particle_volume = s.measure * thickness;
+          particle_mass = materials[mat]->density() * particle_volume;
+        }
+        tally(X, particle_volume);
+        emit(k, X, next_id++, particle_volume, particle_mass, true);
       }
     }
     if (count_of[b] == 0) {
@@ -302,7 +428,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
     }
   }
   check_overlaps(config, shared, count_of);
-  // Initial stresses of pre-deformed bodies.
+  // Initial stresses of pre-deformed bodies (a displacement, or a point file's stresses).
   for (std::size_t p = 0; p < particles.n(); ++p) {
     if (particles.deformation_gradient[p].isIdentity(0.0)) continue;
     const Mat3 L = Mat3::Zero();
@@ -312,14 +438,13 @@ void create_particles(const Config& config, const Grid<D>& grid,
     const MaterialPoint point{particles.deformation_gradient[p], L, state, 0.0};
     particles.kirchhoff_stress[p] = materials[particles.material[p]]->update(point);
   }
-  (void)mode;
 }
 
 template void create_particles<1>(const Config&, const Grid<1>&, const std::vector<std::unique_ptr<Material>>&, Mode,
-                                  Particles<1>&, const ParticleSelection<1>*);
+                                  Particles<1>&, const ParticleSelection<1>*, const GenerationShare<1>*);
 template void create_particles<2>(const Config&, const Grid<2>&, const std::vector<std::unique_ptr<Material>>&, Mode,
-                                  Particles<2>&, const ParticleSelection<2>*);
+                                  Particles<2>&, const ParticleSelection<2>*, const GenerationShare<2>*);
 template void create_particles<3>(const Config&, const Grid<3>&, const std::vector<std::unique_ptr<Material>>&, Mode,
-                                  Particles<3>&, const ParticleSelection<3>*);
+                                  Particles<3>&, const ParticleSelection<3>*, const GenerationShare<3>*);
 
 }  // namespace cairn

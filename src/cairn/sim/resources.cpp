@@ -77,10 +77,11 @@ std::string memory_limit_text(const Config& config, double limit) {
 }  // namespace
 
 std::shared_ptr<const GreyImage> body_image(const BodyConfig& body, const Config& config) {
-  if (body.shape.kind != "image") return nullptr;
+  if (body.shape.kind != "image" && body.shape.kind != "image_stack") return nullptr;
   if (body.shape.image) return body.shape.image;
-  return std::make_shared<const GreyImage>(
-      read_png_grey(resolve_input_relative(body.shape.file, config.source_file)));
+  const std::string file = resolve_input_relative(body.shape.file, config.source_file);
+  return std::make_shared<const GreyImage>(body.shape.kind == "image" ? read_png_grey(file)
+                                                                      : read_png_stack(file, body.shape.pattern));
 }
 
 template <int D>
@@ -116,35 +117,42 @@ ShapeBounds<D> shape_bounds(const BodyShapeConfig& s, const GreyImage* image, co
     }
     const double box = (b.hi - b.lo).prod();
     b.fill = box > 0.0 ? std::min(1.0, 0.5 * std::abs(twice_area) / box) : 1.0;
-  } else if (s.kind == "image" && D == 2 && image) {
-    // The pixels with a level in [level_min, level_max]; pixel (col, row) covers
-    // [ox + col s, ox + (col + 1) s) x [oy + (H - 1 - row) s, oy + (H - row) s).
-    int c0 = image->width, c1 = -1, r0 = image->height, r1 = -1;
+  } else if ((s.kind == "image" || s.kind == "image_stack") && D >= 2 && image) {
+    // The pixels (voxels) with a level in [level_min, level_max]; pixel (col, row) of slice k
+    // covers [ox + col s, ox + (col + 1) s) x [oy + (H - 1 - row) s, oy + (H - row) s)
+    // (x [oz + k dz, oz + (k + 1) dz) in 3D).
+    int c0 = image->width, c1 = -1, r0 = image->height, r1 = -1, k0 = image->depth, k1 = -1;
     long long in_level = 0;
-    for (int row = 0; row < image->height; ++row)
-      for (int col = 0; col < image->width; ++col) {
-        const int level = image->at(col, row);
-        if (level < s.level_min || level > s.level_max) continue;
-        c0 = std::min(c0, col);
-        c1 = std::max(c1, col);
-        r0 = std::min(r0, row);
-        r1 = std::max(r1, row);
-        ++in_level;
-      }
-    const Vec<D> o = vec<D>(s.origin);
-    const double px = s.pixel_size;
-    b.lo[0] = o[0] + c0 * px;
-    b.hi[0] = o[0] + (c1 + 1) * px;
-    b.lo[D - 1] = o[D - 1] + (image->height - 1 - r1) * px;
-    b.hi[D - 1] = o[D - 1] + (image->height - r0) * px;
-    if (in_level > 0)
-      b.fill = static_cast<double>(in_level) / (static_cast<double>(c1 - c0 + 1) * (r1 - r0 + 1));
+    for (int k = 0; k < image->depth; ++k)
+      for (int row = 0; row < image->height; ++row)
+        for (int col = 0; col < image->width; ++col) {
+          const int level = image->at(col, row, k);
+          if (level < s.level_min || level > s.level_max) continue;
+          c0 = std::min(c0, col);
+          c1 = std::max(c1, col);
+          r0 = std::min(r0, row);
+          r1 = std::max(r1, row);
+          k0 = std::min(k0, k);
+          k1 = std::max(k1, k);
+          ++in_level;
+        }
+    const Vec<3> o = vec<3>(s.origin);
+    const double px = s.pixel_size, dz = s.slice_spacing;
+    const double lo[3] = {o[0] + c0 * px, o[1] + (image->height - 1 - r1) * px, o[2] + k0 * dz};
+    const double hi[3] = {o[0] + (c1 + 1) * px, o[1] + (image->height - r0) * px, o[2] + (k1 + 1) * dz};
+    for (int a = 0; a < D; ++a) {
+      b.lo[a] = lo[a];
+      b.hi[a] = hi[a];
+    }
+    const double box_voxels = static_cast<double>(c1 - c0 + 1) * (r1 - r0 + 1) * (k1 - k0 + 1);
+    if (in_level > 0) b.fill = static_cast<double>(in_level) / box_voxels;
   } else if (s.kind == "outline" && D == 2 && !s.loops.empty()) {
     b.lo = b.hi = vec<D>(s.loops[0][0]);
-    for (const auto& v : s.loops[0]) {
-      b.lo = b.lo.cwiseMin(vec<D>(v));
-      b.hi = b.hi.cwiseMax(vec<D>(v));
-    }
+    for (const auto& loop : s.loops)  // (every loop: a cut through a mesh may hold several islands)
+      for (const auto& v : loop) {
+        b.lo = b.lo.cwiseMin(vec<D>(v));
+        b.hi = b.hi.cwiseMax(vec<D>(v));
+      }
     const double box = (b.hi - b.lo).prod();
     b.fill = box > 0.0 ? std::min(1.0, geometry::loops_area(s.loops) / box) : 1.0;
   } else if (s.points) {  // points, volume_mesh

@@ -45,24 +45,29 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   for (const auto& m : materials_) particles_.has_temperature |= m->uses_temperature();
   check_memory<D>(config_, grid_, velocity_fields(config_), n_state, shape_->ghost_layers() + 1, comm.size());
   if (comm.parallel()) {
-    // Per-rank generation (docs/parallel.md): every rank walks the bodies' particles twice and
-    // stores none of them the first time, only the cells of every size-th one (a census whose
-    // histograms, summed over the ranks, are those of all particles), bisects the domain by
-    // them, and stores only the particles of its own box the second time.
+    // Per-rank generation (docs/parallel.md): the ranks walk the bodies' particles twice. The
+    // first time (the census) rank r runs the inside tests of the r-th block of lattice rows of
+    // each lattice body and records the cells of its particles (and of every size-th particle
+    // of the bodies all ranks generate whole): the histograms, summed over the ranks, are those
+    // of all particles. The domain is bisected by them, and the second time each rank tests and
+    // stores only the lattice points of its own box.
     distribution_ = Distribution<D>(comm, whole_);
     const auto rank = static_cast<std::int64_t>(comm.rank()), ranks = static_cast<std::int64_t>(comm.size());
     std::vector<IVec<D>> census;
-    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t, const Vec<D>&, const Vec<D>& x) {
-      if (id % ranks == rank) census.push_back(distribution_.cell_of(x));
+    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t, const Vec<D>&, const Vec<D>& x,
+                                           bool replicated) {
+      if (!replicated || id % ranks == rank) census.push_back(distribution_.cell_of(x));
       return false;
     };
-    create_particles<D>(config_, grid_, materials_, mode_, particles_, &count);
+    const GenerationShare<D> rows{&comm, nullptr};
+    create_particles<D>(config_, grid_, materials_, mode_, particles_, &count, &rows);
     distribution_.partition_cells(census);
     std::vector<IVec<D>>().swap(census);
-    const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x) {
+    const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x, bool) {
       return distribution_.owner_of(x) == comm.rank();
     };
-    create_particles<D>(config_, grid_, materials_, mode_, particles_, &mine);
+    const GenerationShare<D> own{&comm, &distribution_.decomposition()};
+    create_particles<D>(config_, grid_, materials_, mode_, particles_, &mine, &own);
     distribution_.adopt(particles_);
   } else {
     create_particles<D>(config_, grid_, materials_, mode_, particles_);
@@ -169,7 +174,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
         for (int sign = -1; sign <= 1; sign += 2)
           across[particles_.body[p]].insert(Tractions<D>::lattice_site(particles_.reference_position[p],
                                                                       grid_.origin(), particles_.size0[p], a, sign));
-    const ParticleSelection<D> sites = [&](std::int64_t, std::int32_t body, const Vec<D>& X, const Vec<D>&) {
+    const ParticleSelection<D> sites = [&](std::int64_t, std::int32_t body, const Vec<D>& X, const Vec<D>&, bool) {
       const auto b = static_cast<std::size_t>(body);
       IVec<D> ppc;
       for (int a = 0; a < D; ++a) ppc[a] = config_.bodies[b].particles_per_cell[a];

@@ -308,17 +308,32 @@ class Simulation {
 };
 
 /// Which generated particles a rank stores (per-rank generation, docs/parallel.md): called for
-/// every particle the bodies generate, in creation order, with its id (its number in a serial
-/// run), body, reference position X and position x; true stores it. The generation and its
-/// checks (empty bodies, overlaps) visit every particle on every rank, so they decide alike.
+/// every particle the bodies generate on this rank, in creation order, with its id (its number in
+/// a serial run), body, reference position X and position x, and whether every rank generates it
+/// (`replicated`: bodies generated whole on every rank) or only this one (a rank's share of a
+/// lattice body, GenerationShare); true stores it. The checks of the generation (empty bodies,
+/// overlaps) count over every rank, so they decide alike.
 template <int D>
-using ParticleSelection = std::function<bool(std::int64_t id, std::int32_t body, const Vec<D>& X, const Vec<D>& x)>;
+using ParticleSelection =
+    std::function<bool(std::int64_t id, std::int32_t body, const Vec<D>& X, const Vec<D>& x, bool replicated)>;
+
+/// Per-rank generation: the ranks of `comm` split the lattice points of the plain lattice bodies
+/// (no point file or mesh elements, no radial arrangement, no WLS surface particles, no
+/// displacement), so that each runs the inside tests of only its own points. Without a
+/// decomposition (the census that decides it) rank r takes the r-th block of lattice rows;
+/// with one, the points in the cells of its box. Other bodies are generated whole on every rank.
+template <int D>
+struct GenerationShare {
+  const Comm* comm = nullptr;
+  const Decomposition<D>* decomposition = nullptr;
+};
 
 /// Fill `particles` from the [[body]] tables (sim/bodies.cpp): all of them, or those `select`
-/// keeps (ids as in a serial run).
+/// keeps (ids as in a serial run), generated whole or, with `share` on several ranks, per rank.
 template <int D>
 void create_particles(const Config& config, const Grid<D>& grid,
                       const std::vector<std::unique_ptr<Material>>& materials, Mode mode,
-                      Particles<D>& particles, const ParticleSelection<D>* select = nullptr);
+                      Particles<D>& particles, const ParticleSelection<D>* select = nullptr,
+                      const GenerationShare<D>* share = nullptr);
 
 }  // namespace cairn
