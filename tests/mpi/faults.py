@@ -9,6 +9,7 @@ written before the fault must still restart (serially).
 """
 import argparse
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -40,7 +41,11 @@ def rank_pids(job, rank):
 
 def start(args, name, extra_env=None, wrap=None, timeout=None):
     out = args.out / name
-    cmd = [args.cairn, "run", str(args.case), "-q", "-t", "1",
+    # A fresh folder: an earlier run's checkpoints would look like this run's progress.
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.rmtree(out.parent / f"{name}-restarted", ignore_errors=True)
+    # 250 steps: the disks leave the grid at step 306.
+    cmd = [args.cairn, "run", str(args.case), "-q", "-t", "1", "--set", "simulation.max_steps=250",
            "--set", "simulation.end_time=1.0", "--set", "output.checkpoint_every=2e-5",
            "--set", "output.every=1.0", "--set", f'output.directory="{out}"']
     if timeout is not None:
