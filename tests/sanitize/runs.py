@@ -12,6 +12,7 @@ updates and timings assigned round-robin), dims (1D, 3D, geometry from files, sh
 FEM, a restart), mpi (2 ranks).
 """
 import argparse
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -119,9 +120,14 @@ def main():
         if LATEST in cmd:
             cmd[cmd.index(LATEST)] = str(sorted((args.out / "checkpoint").glob("checkpoint-*.h5"))[-1])
         full = [args.cairn] + cmd + ["-q"]
+        env = dict(os.environ)
         if ranks > 1:
             full = [args.mpirun, "--oversubscribe", "--allow-run-as-root", "-np", str(ranks)] + full
-        r = subprocess.run(full, capture_output=True, text=True)
+            # Open MPI's plug-ins (mca_*.so, loaded and unloaded at run time) keep allocations
+            # that LeakSanitizer can no longer name by library: leaks are checked by the serial
+            # runs and the unit tests; memory errors and UB stay fatal here.
+            env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":detect_leaks=0"
+        r = subprocess.run(full, capture_output=True, text=True, env=env)
         report = "Sanitizer" in r.stderr or "runtime error:" in r.stderr
         ok = r.returncode == 0 and not report
         print(f"{'ok  ' if ok else 'FAIL'} {name}: exit {r.returncode}{', sanitizer report' if report else ''}")
