@@ -48,9 +48,12 @@ void print_summary(const cairn::RunSummary& s) {
   if (s.particle_sorts > 0)
     fmt::print("cairn: particles sorted into cell-block order {} time{} (simulation.sort_particles)\n",
                s.particle_sorts, s.particle_sorts == 1 ? "" : "s");
-  if (s.ranks > 1)
+  if (s.ranks > 1) {
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);
+    fmt::print("cairn: halo of {} (parallel.halo), {:.0f} bytes sent per rank and step\n", s.halo,
+               s.halo_bytes_per_step);
+  }
   for (const auto& note : s.body_notes) fmt::print("cairn: {}\n", note);
   fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);
   if (!s.last_checkpoint.empty()) fmt::print("cairn: checkpoint {}\n", s.last_checkpoint.string());

@@ -182,12 +182,21 @@ TEST(InputErrors, BadSetSyntax) {
             "--set body.3.name=x: key 'body[3]': expected the index of an existing [[body]] (0..0); found 3");
 }
 
+TEST(InputErrors, NodeHaloWithContactIsRefusedWithTheReason) {
+  const std::string contact = base + "[contact]\nmode = \"body\"\n";
+  EXPECT_EQ(message(error_of(contact, {"parallel.halo=\"nodes\""})),
+            "--set parallel.halo=\"nodes\": key 'parallel.halo': expected \"particles\" or \"auto\" with [contact] "
+            "(contact normals need the particles around each node; docs/parallel.md); found \"nodes\"");
+  EXPECT_EQ(load_config_string(contact, "case.toml", {}).parallel.halo, "auto");
+  EXPECT_EQ(load_config_string(base, "case.toml", {"parallel.halo=\"nodes\""}).parallel.halo, "nodes");
+}
+
 TEST(InputErrors, SetOfUnknownKey) {
   EXPECT_EQ(message(error_of(base, {"method.ordr=4"})),
             "--set method.ordr=4: key 'method.ordr': expected a key declared for [method] "
             "(did you mean 'order'?); found an undeclared key");
   EXPECT_EQ(message(error_of(base, {"materail[0].density=1"})),
-            "--set materail[0].density=1: key 'materail': expected a section, one of simulation, grid, "
+            "--set materail[0].density=1: key 'materail': expected a section, one of simulation, parallel, grid, "
             "method, constants, material, body, boundary, thermal, body_force, traction, velocity, wall, "
             "contact, contact_pair, fem, output (did you mean "
             "'material'?); found an undeclared key");

@@ -234,3 +234,36 @@ TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
 
 }  // namespace
 }  // namespace cairn
+
+namespace cairn {
+namespace {
+
+TEST(NodeHalo, SharedNodesAreTheSameListFromBothSidesAndHoldEveryNodeBothCanReach) {
+  // 12 x 6 cells, x periodic (the boxes meet twice: at x = 5 and across the seam), y with 2
+  // ghost layers. Box a: cells [0, 5) x [0, 6), box b: [5, 12) x [0, 6); margin 2.
+  Grid<2> whole(Vec<2>(0.0, 0.0), IVec<2>(12, 6), Vec<2>(1.0, 1.0), 2, {true, false});
+  const CellBox<2> a{IVec<2>(0, 0), IVec<2>(5, 6)}, b{IVec<2>(5, 0), IVec<2>(12, 6)};
+  const int margin = 2;
+  const auto ab = NodeHalo<2>::shared_nodes(a, b, whole, margin);
+  const auto ba = NodeHalo<2>::shared_nodes(b, a, whole, margin);
+  EXPECT_EQ(ab, ba);
+  EXPECT_TRUE(std::is_sorted(ab.begin(), ab.end()));
+  // A node with x index i is within `margin` nodes of both boxes' node ranges ([0, 5] and
+  // [5, 12] with 12 = 0) exactly when i is in 3..7 or in 10..11, 0..2 (the seam); every y row of
+  // the stored grid (6 + 1 + 2 x 2 ghosts = 11 rows).
+  std::vector<std::int32_t> expected;
+  for (std::int32_t idx = 0; idx < whole.n_nodes(); ++idx) {
+    const int i = whole.multi_index(idx)[0];
+    if ((i >= 3 && i <= 7) || i >= 10 || i <= 2) expected.push_back(idx);
+  }
+  EXPECT_EQ(ab, expected);
+  EXPECT_EQ(ab.size(), 10u * 11u);
+  // Far apart on a non-periodic axis: nothing shared.
+  Grid<2> open(Vec<2>(0.0, 0.0), IVec<2>(20, 4), Vec<2>(1.0, 1.0), 1, {false, false});
+  const CellBox<2> left{IVec<2>(0, 0), IVec<2>(5, 4)}, right{IVec<2>(10, 0), IVec<2>(20, 4)};
+  EXPECT_TRUE(NodeHalo<2>::shared_nodes(left, right, open, margin).empty());
+  EXPECT_FALSE(NodeHalo<2>::shared_nodes(left, right, open, 3).empty());  // nodes 7 and 8 both
+}
+
+}  // namespace
+}  // namespace cairn

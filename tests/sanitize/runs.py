@@ -9,7 +9,7 @@ A run passes when it exits 0 and prints no sanitizer report (the build makes eve
 fatal, -fno-sanitize-recover=all, so a report is also a non-zero exit). Groups: shapes (two
 disks in multimaterial contact, tests/mpi/cases/contact_disks.toml, under every shape family, the
 updates and timings assigned round-robin), dims (1D, 3D, geometry from files, shocks), engines (WLS 2D and 3D, the
-FEM, a restart), mpi (2 ranks).
+FEM, a restart), mpi (2 and 3 ranks, both halos).
 """
 import argparse
 import os
@@ -98,7 +98,10 @@ def runs(group, out):
         yield ("checkpoint", ["run", str(DISKS)], 1)
         yield ("restart", ["restart", LATEST, "--set", "simulation.max_steps=30"], 1)
     elif group == "mpi":
-        yield ("contact_disks_2ranks", ["run", str(DISKS)], 2)
+        yield ("contact_disks_2ranks", ["run", str(DISKS)], 2)  # (contact: the particle halo)
+        cases = ROOT / "tests" / "mpi" / "cases"
+        yield ("cpdi_wall_2ranks_nodes", ["run", str(cases / "cpdi_wall.toml")], 2)  # node halo, conduction
+        yield ("fmpm_periodic_3ranks_nodes", ["run", str(cases / "fmpm_periodic.toml")], 3)
     else:
         raise SystemExit(f"runs.py: unknown group {group!r}")
 

@@ -49,6 +49,14 @@ struct SimulationConfig {
   SourceLocation where;     ///< the [simulation] table (end_time's line when given)
 };
 
+/// [parallel]: how a run on several MPI ranks shares its grid (docs/parallel.md).
+struct ParallelConfig {
+  /// nodes: each rank scatters its own particles and node sums are exchanged across a halo one
+  /// stencil wide; particles: ghost copies of the neighbours' particles, node sums in serial
+  /// order (bit-identical to a serial run); auto: nodes, or particles with [contact].
+  std::string halo = "auto";
+};
+
 struct GridConfig {
   std::vector<double> origin;     ///< D values
   std::vector<double> extent;     ///< D values: domain size
@@ -285,6 +293,7 @@ struct Config {
   std::string source_file;  ///< path of the input file ("" if built in code)
   std::string resolved_toml;///< the fully resolved input (defaults filled, overrides applied)
   SimulationConfig simulation;
+  ParallelConfig parallel;
   GridConfig grid;
   MethodConfig method;
   std::vector<MaterialConfig> materials;

@@ -473,6 +473,7 @@ class Loader {
   void read_boundary(const toml::table& root, Config& cfg);
   void read_body_force(const toml::table& root, Config& cfg);
   void read_thermal(const toml::table& root, Config& cfg);
+  void read_parallel(const toml::table& root, Config& cfg);
   void read_tractions(const toml::table& root, Config& cfg);
   void read_velocity_conditions(const toml::table& root, Config& cfg);
   void read_walls(const toml::table& root, Config& cfg);

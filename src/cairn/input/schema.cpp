@@ -149,7 +149,7 @@ std::vector<const KeyDecl*> section_keys(std::string_view section) {
 }
 
 const std::vector<std::string>& section_names() {
-  static const std::vector<std::string> names{"simulation", "grid",     "method",
+  static const std::vector<std::string> names{"simulation", "parallel", "grid",     "method",
                                               "constants",  "material", "body",
                                               "boundary",   "thermal",    "body_force", "traction",
                                               "velocity",   "wall",       "contact",    "contact_pair",

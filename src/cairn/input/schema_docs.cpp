@@ -40,6 +40,10 @@ const std::vector<SectionDoc>& section_docs() {
        "origin = [0.0, 0.0]\n"
        "extent = [0.12, 0.04]\n"
        "cell_size = 1.0e-3   # or [1.0e-3, 1.0e-3]\n"},
+      {"parallel", "[parallel]",
+       "How a run on several MPI ranks shares its grid (docs/parallel.md). Ignored on one rank.",
+       "[parallel]\n"
+       "halo = \"nodes\"\n"},
       {"method", "[method]",
        "The numerical method: shape functions, particle update and stress-update timing. The "
        "choices are the names registered in this build.",

@@ -93,6 +93,16 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "rank. docs/robustness.md.")
                 .by_default("300.0")
                 .min(0.0));
+  k.push_back(Key("parallel", "halo", T::string,
+                 "Runs on several MPI ranks (docs/parallel.md): nodes = each rank scatters its own "
+                 "particles and the node sums shared with its neighbours are exchanged (one stencil "
+                 "wide; results equal a serial run's to round-off, and are the same bits run to run "
+                 "on the same ranks); particles = each rank also holds ghost copies of its "
+                 "neighbours' particles and sums nodes in serial order (bit-identical to a serial "
+                 "run, more work and memory per rank); auto = nodes, or particles with [contact] "
+                 "(its normals need the particles around a node). Unused on one rank.")
+                .by_default("\"auto\"")
+                .choices([] { return std::vector<std::string>{"auto", "nodes", "particles"}; }));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,
                  "Refuse a run whose end_time / first time step exceeds this (a run that would "
                  "never end), naming the material that sets the step; 0 = no check. Not checked "

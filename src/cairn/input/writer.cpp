@@ -105,6 +105,9 @@ std::string config_to_toml(const Config& c) {
   line("mpi_timeout", real_text(s.mpi_timeout));
   line("body_overlap", toml_string(s.body_overlap));
 
+  o += "\n[parallel]\n";
+  line("halo", toml_string(c.parallel.halo));
+
   if (!c.fem.enabled) {
     o += "\n[grid]\n";
     line("origin", reals_text(c.grid.origin));

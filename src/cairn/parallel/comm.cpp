@@ -111,6 +111,27 @@ Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers& 
   return recv;
 }
 
+void Comm::exchange_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv) const {
+  const std::size_t k = neighbours.size();
+  if (!parallel() || k == 0) return;
+  constexpr int tag = 7103;
+  std::vector<MPI_Request> requests;
+  requests.reserve(2 * k);
+  for (std::size_t i = 0; i < k; ++i) {
+    if (!recv[i].empty()) {
+      requests.emplace_back();
+      MPI_Irecv(recv[i].data(), checked_count(recv[i].size()), MPI_BYTE, neighbours[i], tag, MPI_COMM_WORLD,
+                &requests.back());
+    }
+    if (!send[i].empty()) {
+      requests.emplace_back();
+      MPI_Isend(send[i].data(), checked_count(send[i].size()), MPI_BYTE, neighbours[i], tag, MPI_COMM_WORLD,
+                &requests.back());
+    }
+  }
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+}
+
 Comm::Buffers Comm::all_to_all(const Buffers& send) const {
   const auto p = static_cast<std::size_t>(size_);
   Buffers recv(p);
@@ -185,6 +206,7 @@ void Comm::broadcast(std::string&, int) const {}
 Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers&) const {
   return Buffers(neighbours.size());
 }
+void Comm::exchange_sized(const std::vector<int>&, const Buffers&, Buffers&) const {}
 Comm::Buffers Comm::all_to_all(const Buffers& send) const { return Buffers{send.at(0)}; }
 void Comm::abort(int code) const { std::exit(code); }
 MpiSession::MpiSession(int*, char***) {}

@@ -67,6 +67,9 @@ class Comm {
   /// Point-to-point exchange with a symmetric neighbour list (b is in a's list iff a is in b's):
   /// send[k] goes to neighbours[k]; returns what neighbours[k] sent, in the same order.
   [[nodiscard]] Buffers exchange(const std::vector<int>& neighbours, const Buffers& send) const;
+  /// The same with sizes both sides know: recv[k] arrives sized for what neighbours[k] sends
+  /// (one round of messages, no size exchange).
+  void exchange_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv) const;
   /// Every rank to every rank: send[r] goes to rank r (size() buffers); returns recv[r] from r.
   [[nodiscard]] Buffers all_to_all(const Buffers& send) const;
 

@@ -1,5 +1,7 @@
 #include "cairn/parallel/distribution.hpp"
 
+#include "cairn/parallel/node_halo.hpp"
+
 #include <algorithm>
 #include <numeric>
 
@@ -118,14 +120,7 @@ void Distribution<D>::migrate(Particles<D>& particles) {
 template <int D>
 Grid<D> Distribution<D>::window(const Grid<D>& whole, int reach) const {
   if (!active()) return whole.whole();
-  const CellBox<D>& box = decomposition_.box(comm_.rank());
-  const int w = window_margin(reach);
-  IVec<D> first, count;
-  for (int a = 0; a < D; ++a) {
-    first[a] = box.lo[a] - w;
-    count[a] = box.hi[a] - box.lo[a] + 1 + 2 * w;
-  }
-  return whole.window(first, count, box.lo, box.hi);
+  return box_window(whole, decomposition_.box(comm_.rank()), window_margin(reach));
 }
 
 template <int D>
@@ -147,6 +142,7 @@ void Distribution<D>::add_ghosts(Particles<D>& particles, int reach) {
   Comm::Buffers send(k_max);
   for (std::size_t k = 0; k < k_max; ++k) pack_particles(particles, send_list_[k], send[k]);
   const Comm::Buffers recv = comm_.exchange(neighbours_, send);
+  for (const auto& b : send) bytes_sent_ += static_cast<std::int64_t>(b.size());
   std::vector<std::size_t> first(k_max + 1, n_owned_);
   for (std::size_t k = 0; k < k_max; ++k) first[k + 1] = first[k] + unpack_particles(particles, recv[k]);
   // Ghosts sorted by id; remember where each neighbour's ghosts went.

@@ -81,6 +81,8 @@ class Distribution {
   /// Remove the ghosts again (the end of a step).
   void drop_ghosts(Particles<D>& particles);
   [[nodiscard]] std::size_t n_owned() const { return n_owned_; }
+  /// Bytes this rank has sent in ghost copies and their refreshes so far.
+  [[nodiscard]] std::int64_t ghost_bytes_sent() const { return bytes_sent_; }
   /// Every local particle (owned and ghost) in increasing id: the serial order.
   [[nodiscard]] const std::vector<std::int32_t>& id_order() const { return id_order_; }
   /// Owners send their current `values` (width entries per particle) to the ghosts' copies.
@@ -90,6 +92,7 @@ class Distribution {
     Comm::Buffers send(neighbours_.size());
     for (std::size_t k = 0; k < neighbours_.size(); ++k) pack_values(values, width, send_list_[k], send[k]);
     const Comm::Buffers recv = comm_.exchange(neighbours_, send);
+    for (const auto& b : send) bytes_sent_ += static_cast<std::int64_t>(b.size());
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
       std::size_t offset = 0;
       const std::size_t row = static_cast<std::size_t>(width);
@@ -114,6 +117,7 @@ class Distribution {
   std::vector<std::vector<std::int32_t>> send_list_;   ///< per neighbour: owned particles sent
   std::vector<std::vector<std::int32_t>> ghost_slot_;  ///< per neighbour: where its ghosts are
   std::vector<std::int32_t> id_order_;
+  mutable std::int64_t bytes_sent_ = 0;
 };
 
 }  // namespace cairn

@@ -224,6 +224,7 @@ class MpmEngine final : public Engine {
     started_ = true;
     start_ = last_autosave_ = Clock::now();
     first_step_ = sim_.step_count();
+    halo_bytes_start_ = sim_.halo_bytes();
     if (!restarted_) {
       clear_earlier_outputs();
       if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
@@ -283,6 +284,12 @@ class MpmEngine final : public Engine {
     summary.body_notes = mesh_volume_notes();
     summary.ranks = comm_.size();
     summary.partitions = sim_.distribution().partitions();
+    summary.halo = sim_.halo();
+    {
+      std::int64_t bytes = comm_.sum(sim_.halo_bytes() - halo_bytes_start_);
+      summary.halo_bytes_per_step =
+          summary.steps > 0 ? static_cast<double>(bytes) / comm_.size() / static_cast<double>(summary.steps) : 0.0;
+    }
     summary.migrated = comm_.sum(sim_.distribution().received());
     summary.max_imbalance = max_imbalance_;
     summary.particle_steps_per_second =
@@ -506,6 +513,7 @@ class MpmEngine final : public Engine {
   std::filesystem::path last_checkpoint_;
   Clock::time_point start_{}, last_autosave_{};
   long long first_step_ = 0;
+  std::int64_t halo_bytes_start_ = 0;  ///< halo bytes sent before this run's first step
   bool started_ = false;
   std::unique_ptr<ThreadTuner> tuner_;
 };

@@ -24,6 +24,8 @@ struct RunSummary {
   std::string item = "particle";          ///< what n_particles counts ("element" for FEM runs)
   std::string xdmf = "particles.xdmf";    ///< the snapshot index in output_directory
   int ranks = 1;                ///< MPI ranks the run was distributed over
+  std::string halo;             ///< several ranks: parallel.halo in effect (nodes | particles)
+  double halo_bytes_per_step = 0.0;  ///< several ranks: mean bytes a rank sent per step in halo exchanges
   int partitions = 0;           ///< domain partitions (start-up and repartitions), several ranks
   long long migrated = 0;       ///< particles that moved between ranks
   double max_imbalance = 1.0;   ///< largest particle imbalance seen at a step's start

@@ -30,10 +30,11 @@ template <class Finish>
 void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector<Vec<D>>& out, Finish&& finish,
                                       SlotRange slots) {
   // S+ S u: U_p = sum_i S_pi u_i, then (S+ U)_i = sum_p M_p S_pi U_p / m_i (seed 000 Sec. 2.1).
-  if (!distributed()) {
+  if (!distributed() || node_halo_) {
     // One pass: each particle's U_p is formed and scattered while its stencil is at hand (`in`
     // is only read, so the colour sweep may gather it; the same sums in the same order).
-    for_each_node(slots, [&](std::int32_t i) { out[i].setZero(); });
+    // (A node-halo run sends every shared node's partial: all of them start from zero.)
+    for_each_node(node_halo_ ? SlotRange{0, n_slots()} : slots, [&](std::int32_t i) { out[i].setZero(); });
     // Through raw pointers read once, the particle's field offset added to them: Eigen's vector
     // stores may alias anything, so through the std::vectors every entry reloaded their data
     // pointers and added the offset to the node.
@@ -52,6 +53,7 @@ void Simulation<D>::lumped_projection(const std::vector<Vec<D>>& in, std::vector
       const double M = mass[p];
       stencil.for_each([&](std::int32_t node, double S, const Vec<D>&) { out_f[node] += (S * M) * U; });
     });
+    sum_halo(out);
   } else {
     lumped_projection_distributed(in, out);
   }
@@ -215,6 +217,7 @@ void Simulation<D>::reextrapolate_momentum() {
       grid_term_[node + off] += (S * particles_.mass[p]) * particles_.velocity[p];
     });
   });
+  sum_halo(grid_term_);
   if (contact_)  // the re-extrapolated momenta obey contact too (same normals and separations)
     contact_->correct(nodes_.mass, grid_term_, true, Contact<D>::Pass::stress, time_, step_dt_, nullptr);
 }

@@ -96,8 +96,14 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     on(StepPoint::end_of_step, [this](double dt) {
       refresh_ghosts(particles_.temperature, particles_.has_temperature ? 1 : 0);
       std::function<void(std::vector<Vec<D>>&)> share_flux;
-      if (distributed()) share_flux = [this](std::vector<Vec<D>>& flux) { refresh_ghosts(flux); };
-      conduction_->step(cache_, particles_, dt, share_flux);
+      std::function<void(std::vector<double>&, std::vector<double>*)> sum_nodes;
+      if (distributed() && !node_halo_) share_flux = [this](std::vector<Vec<D>>& flux) { refresh_ghosts(flux); };
+      if (node_halo_)
+        sum_nodes = [this](std::vector<double>& a, std::vector<double>* b) {
+          if (b) halo_.sum(1, a, *b);
+          else halo_.sum(1, a);
+        };
+      conduction_->step(cache_, particles_, dt, share_flux, sum_nodes);
     });
   }
   double max_mass = 0.0;
@@ -241,7 +247,8 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // grid (docs/parallel.md).
     velocity_conditions_.set_comm(comm);
     reach_ = std::max(1, shape_->ghost_layers());
-    grid_ = distribution_.window(whole_, reach_);
+    node_halo_ = config_.parallel.halo == "nodes" || (config_.parallel.halo == "auto" && !contact_);
+    grid_ = node_halo_ ? node_window() : distribution_.window(whole_, reach_);
   }
   keep_particles_sorted(true);
   allocate_nodes();

@@ -20,6 +20,7 @@
 #include "cairn/materials/material.hpp"
 #include "cairn/parallel/comm.hpp"
 #include "cairn/parallel/distribution.hpp"
+#include "cairn/parallel/node_halo.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/schemes/scheme.hpp"
 #include "cairn/shapes/shape_family.hpp"
@@ -106,6 +107,12 @@ class Simulation {
   /// The ranks of the run and this rank's share (docs/parallel.md).
   [[nodiscard]] const Comm& comm() const { return distribution_.comm(); }
   [[nodiscard]] const Distribution<D>& distribution() const { return distribution_; }
+  /// How this rank shares nodes with the others: "nodes", "particles", or "" on one rank.
+  [[nodiscard]] std::string halo() const { return !distributed() ? "" : node_halo_ ? "nodes" : "particles"; }
+  /// Bytes this rank has sent in halo exchanges (node sums, or ghost copies and refreshes).
+  [[nodiscard]] std::int64_t halo_bytes() const {
+    return node_halo_ ? halo_.bytes_sent() : distribution_.ghost_bytes_sent();
+  }
   /// Largest particle count of a rank over the mean count at the start of the last step (1 on
   /// one rank).
   [[nodiscard]] double imbalance() const { return imbalance_; }
@@ -191,6 +198,16 @@ class Simulation {
   /// A distributed step's start: imbalance, repartition, migration; then ghosts, window and
   /// stencils until the stencils fit the window.
   void distribute_and_build();
+  /// A node-halo step's start: migration and stencils of the owned particles on a window one
+  /// reach (and a cell, for traction faces) beyond the box, then the halo's shared nodes.
+  void distribute_nodes_and_build();
+  /// The largest stencil reach over the ranks (collective): when it exceeds reach_, reach_ takes
+  /// it and true is returned (the windows must widen); otherwise the cache records it.
+  bool widened_to_global_reach();
+  /// This rank's window for a node halo at the current reach.
+  [[nodiscard]] Grid<D> node_window() const {
+    return box_window(whole_, distribution_.decomposition().box(distribution_.comm().rank()), reach_ + 1);
+  }
   /// Named points of the step where optional features attach (their set-up calls on()):
   /// after the internal forces (tractions), after mass and momentum (contact's nodes, normals and
   /// first correction), before the grid velocity conditions (contact's second correction), after
@@ -213,7 +230,13 @@ class Simulation {
   /// A distributed run: owners send the ghost copies the current values of a per-particle array.
   template <class T>
   void refresh_ghosts(std::vector<T>& values, int width = 1) {
-    distribution_.refresh(values, width);
+    if (!node_halo_) distribution_.refresh(values, width);
+  }
+  /// A node-halo run (parallel.halo): sum node arrays (n_slots() entries each) over the ranks
+  /// sharing their nodes; a no-op otherwise (one rank, or ghost particles).
+  template <class... T>
+  void sum_halo(std::vector<T>&... arrays) {
+    if (node_halo_) halo_.sum(n_fields_, arrays...);
   }
   [[nodiscard]] bool distributed() const { return distribution_.active(); }
   /// Particles this rank updates: all local ones outside a step, the owned ones during it.
@@ -258,6 +281,8 @@ class Simulation {
   Grid<D> whole_;  ///< the whole grid (geometry)
   Grid<D> grid_;   ///< the stored grid: whole_, or this rank's window of it
   Distribution<D> distribution_;
+  bool node_halo_ = false;  ///< several ranks exchanging node sums (parallel.halo = nodes)
+  NodeHalo<D> halo_;
   int reach_ = 1;             ///< stencil reach the window and ghost band are sized for
   double imbalance_ = 1.0;
   std::set<std::string> reported_pairs_;  ///< rank 0 of a distributed run: conflicts noted

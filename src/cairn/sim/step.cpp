@@ -192,7 +192,64 @@ void Simulation<D>::build_stencils() {
 }
 
 template <int D>
+bool Simulation<D>::widened_to_global_reach() {
+  std::int64_t reach[2 * D];
+  for (int a = 0; a < D; ++a) {
+    reach[a] = cache_.reach_lo[a];
+    reach[D + a] = cache_.reach_hi[a];
+  }
+  distribution_.comm().max(reach, 2 * D);
+  std::int64_t needed = 0;
+  for (auto r : reach) needed = std::max(needed, r);
+  if (needed > reach_) {
+    reach_ = static_cast<int>(needed);
+    return true;
+  }
+  for (int a = 0; a < D; ++a) {
+    cache_.reach_lo[a] = static_cast<int>(reach[a]);
+    cache_.reach_hi[a] = static_cast<int>(reach[D + a]);
+  }
+  return false;
+}
+
+template <int D>
+void Simulation<D>::distribute_nodes_and_build() {
+  const Comm& comm = distribution_.comm();
+  distribution_.migrate(particles_);
+  imbalance_ = distribution_.imbalance(particles_.n());
+  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) distribution_.partition(particles_);
+  for (;;) {
+    set_window(node_window());
+    std::optional<SimulationFailure> failure;
+    try {
+      shape_->build(grid_, particles_, cache_);
+    } catch (const SimulationFailure& f) {
+      failure = f;
+    }
+    // The window must hold the stencils of every rank's particles at the largest reach (CPDI
+    // domains stretch): a wider reach widens every window and the step starts over.
+    if (widened_to_global_reach()) continue;
+    // With the reach covered, a stencil leaving the window leaves the stored grid: the failure
+    // of a serial run.
+    if (comm.any(failure.has_value())) collectively([&] {
+        if (failure) throw *failure;
+      });
+    break;
+  }
+  if (!halo_.built_for(reach_ + 1, distribution_.partitions()))
+    halo_.build(comm, distribution_.decomposition(), whole_, reach_ + 1, distribution_.partitions());
+  cache_.n_owned = particles_.n();
+  cache_.id_order.clear();
+  tractions_.localise(particles_, particles_.n());
+  compute_field_offsets();
+}
+
+template <int D>
 void Simulation<D>::distribute_and_build() {
+  if (node_halo_) {
+    distribute_nodes_and_build();
+    return;
+  }
   const Comm& comm = distribution_.comm();
   // Particles that crossed into another box move there; the imbalance is measured on the
   // result, and beyond the threshold the boxes are bisected anew (docs/parallel.md).
@@ -213,16 +270,7 @@ void Simulation<D>::distribute_and_build() {
     }
     // The window and ghost band must cover the stencils' reach over all ranks' particles; a
     // wider reach (CPDI domains stretch) widens them and the step starts over.
-    std::int64_t reach[2 * D];
-    for (int a = 0; a < D; ++a) {
-      reach[a] = cache_.reach_lo[a];
-      reach[D + a] = cache_.reach_hi[a];
-    }
-    comm.max(reach, 2 * D);
-    std::int64_t needed = 0;
-    for (auto r : reach) needed = std::max(needed, r);
-    if (needed > reach_) {
-      reach_ = static_cast<int>(needed);
+    if (widened_to_global_reach()) {
       distribution_.drop_ghosts(particles_);
       continue;
     }
@@ -239,10 +287,6 @@ void Simulation<D>::distribute_and_build() {
       ++reach_;
       distribution_.drop_ghosts(particles_);
       continue;
-    }
-    for (int a = 0; a < D; ++a) {
-      cache_.reach_lo[a] = static_cast<int>(reach[a]);
-      cache_.reach_hi[a] = static_cast<int>(reach[D + a]);
     }
     break;
   }
@@ -334,7 +378,19 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   };
   if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
   else extrapolate(std::false_type{});
-  if (forces) run_hooks(StepPoint::after_forces, step_dt_);
+  if (forces) run_hooks(StepPoint::after_forces, step_dt_);  // (tractions: this rank's faces)
+  // A node-halo run completes the sums at the nodes its neighbours share, in one exchange.
+  if (node_halo_) {
+    if (mass_and_momentum && forces) {
+      if (has_body_force) sum_halo(nodes_.mass, nodes_.momentum, nodes_.force, node_body_force_);
+      else sum_halo(nodes_.mass, nodes_.momentum, nodes_.force);
+    } else if (mass_and_momentum) {
+      sum_halo(nodes_.mass, nodes_.momentum);
+    } else if (forces) {
+      if (has_body_force) sum_halo(nodes_.force, node_body_force_);
+      else sum_halo(nodes_.force);
+    }
+  }
   if (mass_and_momentum) run_hooks(StepPoint::after_momentum, step_dt_);
 }
 
@@ -397,6 +453,8 @@ void Simulation<D>::update_grid(double dt) {
   template void Simulation<D>::wls_step(double); \
   template void Simulation<D>::build_stencils(); \
   template void Simulation<D>::distribute_and_build(); \
+  template void Simulation<D>::distribute_nodes_and_build(); \
+  template bool Simulation<D>::widened_to_global_reach(); \
   template void Simulation<D>::compute_body_forces(); \
   template void Simulation<D>::particles_to_grid(bool, bool); \
   template void Simulation<D>::update_grid(double); \

@@ -55,7 +55,8 @@ double Conduction<D>::stable_dt(const Particles<D>& particles, const std::vector
 
 template <int D>
 void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double dt,
-                         const std::function<void(std::vector<Vec<D>>&)>& share_flux) {
+                         const std::function<void(std::vector<Vec<D>>&)>& share_flux,
+                         const std::function<void(std::vector<double>&, std::vector<double>*)>& sum_nodes) {
   const auto n = grid_->n_nodes();
   for_each_node(n, [&](std::int32_t i) {
     capacity_[i] = 0.0;
@@ -69,6 +70,7 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
       temperature_[node] += c * P.temperature[p];
     });
   });
+  if (sum_nodes) sum_nodes(capacity_, &temperature_);
   for_each_node(n, [&](std::int32_t i) {
     temperature_[i] = capacity_[i] > 0.0 ? temperature_[i] / capacity_[i] : 0.0;
   });
@@ -90,6 +92,7 @@ void Conduction<D>::step(const TransferCache<D>& cache, Particles<D>& P, double 
   scatter(cache, [&](std::int32_t p, const auto& stencil) {
     stencil.for_each([&](std::int32_t node, double, const Vec<D>& G) { heat_[node] -= flux_[p].dot(G); });
   });
+  if (sum_nodes) sum_nodes(heat_, nullptr);
   for (const auto& [i, f] : face_nodes_)
     if (config_.face[f] == ThermalFace::flux && capacity_[i] > 0.0) heat_[i] += config_.value[f] * face_area_[f];
   for_each_node(n, [&](std::int32_t i) {

@@ -35,9 +35,12 @@ class Conduction {
   void grid_changed();
   /// One explicit conduction step over the transfer cache of the current mechanical step.
   /// `share_flux` (a distributed run) gives the ghost particles their owners' heat fluxes
-  /// between the gather that computes them and the scatter that reads them.
+  /// between the gather that computes them and the scatter that reads them; `sum_nodes` (a
+  /// node-halo run) completes the node sums after each scatter: (capacity, temperature), then
+  /// (heat, null).
   void step(const TransferCache<D>& cache, Particles<D>& particles, double dt,
-            const std::function<void(std::vector<Vec<D>>&)>& share_flux = {});
+            const std::function<void(std::vector<Vec<D>>&)>& share_flux = {},
+            const std::function<void(std::vector<double>&, std::vector<double>*)>& sum_nodes = {});
   /// Largest stable time step for the particles' materials (infinity when nothing conducts).
   [[nodiscard]] double stable_dt(const Particles<D>& particles, const std::vector<double>& density) const;
 
