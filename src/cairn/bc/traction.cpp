@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "cairn/config/errors.hpp"
+#include "cairn/parallel/particle_transfer.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 
@@ -202,7 +203,9 @@ void Tractions<D>::renumber(const std::vector<std::int32_t>& old_index) {
   std::vector<std::int32_t> new_index(old_index.size());
   for (std::size_t k = 0; k < old_index.size(); ++k) new_index[static_cast<std::size_t>(old_index[k])] = static_cast<std::int32_t>(k);
   for (auto* faces : {&faces_, &all_faces_})
-    for (Face& f : *faces) f.particle = new_index[static_cast<std::size_t>(f.particle)];
+    for (Face& f : *faces)
+      if (f.particle >= 0 && static_cast<std::size_t>(f.particle) < new_index.size())  // (other ranks' faces: localise)
+        f.particle = new_index[static_cast<std::size_t>(f.particle)];
 }
 
 template <int D>
@@ -212,15 +215,31 @@ void Tractions<D>::localise(const Particles<D>& particles, std::size_t n_owned) 
   const auto owned_end = ids + static_cast<std::ptrdiff_t>(n_owned);
   const auto all_end = ids + static_cast<std::ptrdiff_t>(particles.n());
   faces_.clear();
-  for (Face f : all_faces_) {
-    auto at = std::lower_bound(ids, owned_end, f.id);
-    f.owned = at != owned_end && *at == f.id;
-    if (!f.owned) {
-      at = std::lower_bound(owned_end, all_end, f.id);
-      if (at == all_end || *at != f.id) continue;
+  if (n_owned == particles.n() && !std::is_sorted(ids, all_end)) {
+    // Storage in cell-block order (a node-halo rank; every particle owned): look ids up through
+    // the storage sorted by id.
+    std::vector<std::int32_t> by_id;
+    storage_in_id_order(particles, by_id);
+    auto id_at = [&](std::int32_t k) { return particles.id[static_cast<std::size_t>(k)]; };
+    for (Face f : all_faces_) {
+      const auto at = std::lower_bound(by_id.begin(), by_id.end(), f.id,
+                                       [&](std::int32_t k, std::int64_t id) { return id_at(k) < id; });
+      if (at == by_id.end() || id_at(*at) != f.id) continue;
+      f.owned = true;
+      f.particle = *at;
+      faces_.push_back(f);
     }
-    f.particle = static_cast<std::int32_t>(at - ids);
-    faces_.push_back(f);
+  } else {
+    for (Face f : all_faces_) {
+      auto at = std::lower_bound(ids, owned_end, f.id);
+      f.owned = at != owned_end && *at == f.id;
+      if (!f.owned) {
+        at = std::lower_bound(owned_end, all_end, f.id);
+        if (at == all_end || *at != f.id) continue;
+      }
+      f.particle = static_cast<std::int32_t>(at - ids);
+      faces_.push_back(f);
+    }
   }
   points_.resize(faces_.size());
   for (std::size_t q = 0; q < faces_.size(); ++q) {

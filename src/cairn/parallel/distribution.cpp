@@ -100,7 +100,7 @@ void Distribution<D>::migrate(Particles<D>& particles) {
   // Owned particles in increasing id: the kept ones already are (unless they came from a
   // checkpoint slab or a replicated setup in another order), the arrivals are sorted and merged.
   const bool kept_sorted = std::is_sorted(particles.id.begin(), particles.id.begin() + static_cast<std::ptrdiff_t>(kept));
-  if (arrived > 0 || !kept_sorted) {
+  if (!keep_storage_order_ && (arrived > 0 || !kept_sorted)) {
     std::vector<std::int32_t> order;
     if (kept_sorted) {
       std::vector<std::int32_t> head(kept);

@@ -65,8 +65,11 @@ class Distribution {
   /// Largest particle count of a rank over the mean count (1 for a serial run; collective).
   [[nodiscard]] double imbalance(std::size_t n_owned) const;
   /// Send the particles that left this rank's box to their owners and take in those that
-  /// entered it; the owned particles stay in increasing id (collective).
+  /// entered it; the owned particles stay in increasing id (collective), unless
+  /// keep_storage_order(true): then the staying particles keep their storage order and the
+  /// arrivals follow them (the node halo, whose storage is sorted by cell block).
   void migrate(Particles<D>& particles);
+  void keep_storage_order(bool keep) { keep_storage_order_ = keep; }
 
   /// Ghost band B and window margin W for stencils of reach r (see above).
   [[nodiscard]] static int ghost_band(int reach) { return 2 * reach + 3; }
@@ -118,6 +121,7 @@ class Distribution {
   std::vector<std::vector<std::int32_t>> ghost_slot_;  ///< per neighbour: where its ghosts are
   std::vector<std::int32_t> id_order_;
   mutable std::int64_t bytes_sent_ = 0;
+  bool keep_storage_order_ = false;
 };
 
 }  // namespace cairn

@@ -248,6 +248,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     velocity_conditions_.set_comm(comm);
     reach_ = std::max(1, shape_->ghost_layers());
     node_halo_ = config_.parallel.halo == "nodes" || (config_.parallel.halo == "auto" && !contact_);
+    distribution_.keep_storage_order(node_halo_);  // (sorted by cell block as a serial run's)
     grid_ = node_halo_ ? node_window() : distribution_.window(whole_, reach_);
   }
   keep_particles_sorted(true);
@@ -329,7 +330,7 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
   // in id order whatever their storage order (transfer/colouring.cpp), and every other particle
   // stage works particle by particle or sums exactly, so the results do not change by a bit.
   const std::size_t n = particles_.n();
-  if (!config_.simulation.sort_particles || distributed() || wls_ || n < sort_min_particles ||
+  if (!config_.simulation.sort_particles || (distributed() && !node_halo_) || wls_ || n < sort_min_particles ||
       particles_.id.size() != n)
     return;
   if (setup) {

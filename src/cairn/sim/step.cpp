@@ -215,9 +215,16 @@ bool Simulation<D>::widened_to_global_reach() {
 template <int D>
 void Simulation<D>::distribute_nodes_and_build() {
   const Comm& comm = distribution_.comm();
+  // Storage sorted by cell block as in a serial run (the last colouring still indexes it), then
+  // the migration: leavers out, arrivals appended.
+  keep_particles_sorted(false);
+  const std::size_t n_before = particles_.n();
+  const std::int64_t received_before = distribution_.received();
   distribution_.migrate(particles_);
   imbalance_ = distribution_.imbalance(particles_.n());
   if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) distribution_.partition(particles_);
+  if (particles_.n() != n_before || distribution_.received() != received_before)
+    cache_.colouring_valid = false;  // block_of and order index the storage before the migration
   for (;;) {
     set_window(node_window());
     std::optional<SimulationFailure> failure;
