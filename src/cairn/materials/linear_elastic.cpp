@@ -24,7 +24,7 @@
 // so that for small strains sigma = C : (eps + beta d eps/dt) and every elastic mode of angular
 // frequency omega decays at the damping ratio zeta = beta omega / 2 (Rayleigh's
 // stiffness-proportional damping). Not in the seeds: Cairn's option against the friction flutter
-// of verification/incline_friction_bounce (docs/materials.md, "Damping"). The stress's work
+// of verification/incline_friction_bounce (docs/materials.md, "Kelvin-Voigt damping"). Its work
 // tau_v : D dt per unit reference volume is kept in the particle's one state variable and counted
 // in the history's dissipated_energy; the time step shrinks with it (Simulation::next_dt).
 #include <algorithm>
@@ -171,6 +171,7 @@ class LinearElastic final : public Material {
     }
   }
 
+  /// The elastic part of update_stress: the stored-energy stress of F, six components.
   void elastic_stress(const MaterialPoint& point, SymMat3& tau) const {
     const Mat3& F = point.F;
     if (form_ == Form::corotational) {
@@ -266,7 +267,7 @@ MaterialModelInfo info() {
       "Kelvin-Voigt retardation time beta (s): adds the viscous stress beta (lambda tr(D) I + 2G D), "
       "which damps every elastic mode at zeta = beta omega / 2; its work goes to dissipated_energy and "
       "the time step shrinks by sqrt(1 + zeta^2) - zeta, zeta = beta c / h. 0 = elastic (seed behaviour). "
-      "Not in plane stress (docs/materials.md, \"Damping\")";
+      "Not in plane stress (docs/materials.md, \"Kelvin-Voigt damping\")";
   keys.push_back(damping);
   return {"isotropic linear elasticity (corotational or small-strain), optional Kelvin-Voigt damping", keys,
           &check_elastic_constants};
