@@ -1,13 +1,16 @@
-// Kelvin-Voigt damping of linear_elastic (damping_time = beta; docs/materials.md, "Damping"): the
+// Kelvin-Voigt damping of linear_elastic (damping_time = beta; docs/materials.md): the
 // viscous stress by hand, no effect when off, a free bar's mode decaying at the analytic damping
-// ratio zeta = beta omega / 2 with its energy balance closed, and the stable time step.
+// ratio zeta = beta omega / 2 with its energy balance closed, the stable time step, and the
+// refusals (plane stress, the FEM).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
+#include "../fem/fem_case.hpp"
 #include "../support/config_builder.hpp"
+#include "cairn/fem/solver.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/sim/simulation.hpp"
 
@@ -166,6 +169,17 @@ TEST(Damping, TheTimeStepShrinksBySqrtOnePlusZetaSquaredMinusZeta) {
     const double expected = cfg.simulation.cfl * h / (c * (std::sqrt(1.0 + zeta * zeta) + zeta));
     EXPECT_NEAR(sim.next_dt() / expected, 1.0, 1e-12) << "beta " << b;
   }
+}
+
+TEST(Damping, TheFemRefusesIt) {
+  // The FEM's energy totals and time step do not know the viscous stress.
+  Config cfg = test::fem_config("shape = { box = { min = [0.0, 0.0], max = [1.0, 1.0] } }\nsize = 0.25\n");
+  cfg.materials[0].model = "linear_elastic";
+  cfg.materials[0].strings["form"] = "corotational";
+  cfg.materials[0].numbers["damping_time"] = 1e-4;
+  EXPECT_THROW(fem::Solver solver(cfg), std::invalid_argument);
+  cfg.materials[0].numbers["damping_time"] = 0.0;
+  EXPECT_NO_THROW(fem::Solver solver(cfg));
 }
 
 TEST(Damping, PlaneStressRefusesIt) {
