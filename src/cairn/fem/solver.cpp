@@ -46,6 +46,9 @@ void Solver::setup() {
     if (m.name == cfg.fem.material) mc = &m;
   if (!mc) throw std::invalid_argument("fem.material '" + cfg.fem.material + "' names no [[material]]");
   material_ = make_material(*mc);
+  // The FEM's energy totals and time step know nothing of a viscous stress (docs/materials.md).
+  if (material_->damping_time() > 0.0)
+    throw std::invalid_argument("material '" + mc->name + "': damping_time is not available in the FEM ([fem])");
   n_state_ = material_->n_state();
 
   const std::size_t nn = mesh_.n_nodes(), ne = mesh_.n_elements();

@@ -18,6 +18,15 @@
 //
 // In 1D (uniaxial strain, F = diag(f, 1, 1), f > 0) the two forms are the same function:
 // tau_xx = f (f - 1)(lambda + 2G).
+//
+// damping_time = beta > 0 adds a Kelvin-Voigt viscous stress proportional to the stiffness,
+//     sigma_v = beta (lambda tr(D) I + 2G D),   D = sym(L),   tau_v = J sigma_v,
+// so that for small strains sigma = C : (eps + beta d eps/dt) and every elastic mode of angular
+// frequency omega decays at the damping ratio zeta = beta omega / 2 (Rayleigh's
+// stiffness-proportional damping). Not in the seeds: Cairn's option against the friction flutter
+// of verification/incline_friction_bounce (docs/materials.md, "Kelvin-Voigt damping"). Its work
+// tau_v : D dt per unit reference volume is kept in the particle's one state variable and counted
+// in the history's dissipated_energy; the time step shrinks with it (Simulation::next_dt).
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -115,7 +124,30 @@ bool is_planar(const Mat3& F) {
 class LinearElastic final : public Material {
  public:
   explicit LinearElastic(const MaterialConfig& cfg)
-      : Material(cfg), c_(elastic_constants(cfg)), form_(parse_form(cfg)) {}
+      : Material(cfg),
+        c_(elastic_constants(cfg)),
+        form_(parse_form(cfg)),
+        beta_(cfg.has("damping_time") ? cfg.number("damping_time") : 0.0) {}
+
+  int n_state() const override { return beta_ > 0.0 ? 1 : 0; }
+  bool uses_increment() const override { return beta_ > 0.0; }
+  double damping_time() const override { return beta_; }
+  double dissipated_energy_density(const double* state) const override {
+    return beta_ > 0.0 && state != nullptr ? state[0] : 0.0;
+  }
+  std::vector<StateVariable> state_variables() const override {
+    if (!(beta_ > 0.0)) return {};
+    return {{"viscous_dissipation", 0, Quantity::energy, Quantity::volume,
+             "work of the Kelvin-Voigt stress (damping_time) per unit reference volume"}};
+  }
+
+  /// The general update (plane stress, the FEM): the elastic stress plus the viscous stress of
+  /// point.L; the dissipated work is counted only by update_stress.
+  Mat3 update(const MaterialPoint& point) const override {
+    Mat3 tau = kirchhoff(point.F);
+    if (beta_ > 0.0) tau += viscous_kirchhoff(point);
+    return tau;
+  }
 
   Mat3 kirchhoff(const Mat3& F) const override {
     if (form_ == Form::corotational) return corotational(stretch_strain(F, is_planar(F)));
@@ -123,6 +155,24 @@ class LinearElastic final : public Material {
   }
 
   void update_stress(const MaterialPoint& point, SymMat3& tau) const override {
+    elastic_stress(point, tau);
+    if (beta_ > 0.0) {
+      const Mat3 tau_v = viscous_kirchhoff(point);
+      auto& v = tau.voigt();  // xx, yy, zz, yz, xz, xy
+      v[0] += tau_v(0, 0);
+      v[1] += tau_v(1, 1);
+      v[2] += tau_v(2, 2);
+      v[3] += tau_v(1, 2);
+      v[4] += tau_v(0, 2);
+      v[5] += tau_v(0, 1);
+      // Stress power per unit reference volume tau_v : D >= 0 (K tr(D)^2 + 2G |dev D|^2).
+      const Mat3 D = 0.5 * (point.L + point.L.transpose());
+      point.state[0] += tau_v.cwiseProduct(D).sum() * point.dt;
+    }
+  }
+
+  /// The elastic part of update_stress: the stored-energy stress of F, six components.
+  void elastic_stress(const MaterialPoint& point, SymMat3& tau) const {
     const Mat3& F = point.F;
     if (form_ == Form::corotational) {
       tau = corotational(stretch_strain(F, point.planar));
@@ -163,6 +213,15 @@ class LinearElastic final : public Material {
   }
 
  private:
+  /// tau_v = J beta (lambda tr(D) I + 2G D) with D = sym(point.L).
+  Mat3 viscous_kirchhoff(const MaterialPoint& point) const {
+    const Mat3 D = 0.5 * (point.L + point.L.transpose());
+    const Mat3& F = point.F;
+    const double J = point.planar ? (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0)) * F(2, 2) : F.determinant();
+    Mat3 tau_v = (J * beta_ * 2.0 * c_.shear) * D;
+    tau_v.diagonal().array() += J * beta_ * c_.lambda * D.trace();
+    return tau_v;
+  }
   /// tau = 2G (B - V) + lambda (tr V - 3) V = 2G (E + E^2) + lambda tr(E) (I + E), E = V - I.
   Mat3 corotational(const Mat3& E) const {
     const double trE = E.trace();
@@ -188,6 +247,7 @@ class LinearElastic final : public Material {
 
   ElasticConstants c_;
   Form form_;
+  double beta_;  ///< damping_time: Kelvin-Voigt retardation time (0: elastic)
   mutable std::atomic<int> warned_{0};  ///< 0: no, 1: seen, not yet said, 2: said
 };
 
@@ -197,7 +257,20 @@ MaterialModelInfo info() {
       "form", "corotational", {"corotational", "small_strain"},
       "corotational: Hooke's law on the Biot strain U - I of F = R U (objective, any rotation); "
       "small_strain: eps = sym(F) - I (seed 003 Sec. 6; not objective, warns past 5 degrees of rotation)"));
-  return {"isotropic linear elasticity (corotational or small-strain)", keys, &check_elastic_constants};
+  KeyDecl damping;
+  damping.section = "material";
+  damping.name = "damping_time";
+  damping.type = KeyType::real;
+  damping.default_value = "0.0";
+  damping.min = 0.0;
+  damping.doc =
+      "Kelvin-Voigt retardation time beta (s): adds the viscous stress beta (lambda tr(D) I + 2G D), "
+      "which damps every elastic mode at zeta = beta omega / 2; its work goes to dissipated_energy and "
+      "the time step shrinks by sqrt(1 + zeta^2) - zeta, zeta = beta c / h. 0 = elastic (seed behaviour). "
+      "Not in plane stress (docs/materials.md, \"Kelvin-Voigt damping\")";
+  keys.push_back(damping);
+  return {"isotropic linear elasticity (corotational or small-strain), optional Kelvin-Voigt damping", keys,
+          &check_elastic_constants};
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 // validator uses for the [[material]] tables.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <span>
 #include <string>
@@ -77,6 +78,16 @@ class Material {
   /// Whether wave_speed depends on F (if not, the time step asks once per material, not once
   /// per particle).
   [[nodiscard]] virtual bool wave_speed_varies() const { return true; }
+  /// Retardation time beta (s) of a Kelvin-Voigt viscous stress beta C : D proportional to the
+  /// elastic stiffness C (0: none; docs/materials.md, "Damping"). Damps every mode at
+  /// zeta = beta omega / 2 and shortens the stable time step, which next_dt accounts for.
+  [[nodiscard]] virtual double damping_time() const { return 0.0; }
+  /// Energy per unit reference volume the model has dissipated (a viscous stress's work), kept
+  /// in its state; part of the history's dissipated_energy, not of strain_energy.
+  [[nodiscard]] virtual double dissipated_energy_density(const double* state) const {
+    (void)state;
+    return 0.0;
+  }
 
   /// Whether update()/update_stress() read MaterialPoint::L or MaterialPoint::dF. Models that
   /// do not (hyperelastic laws) get L = 0 and dF = I there, so the step need not assemble the
@@ -103,6 +114,19 @@ class Material {
   std::string name_;
   double density_;
 };
+
+/// The signal speed that gives a damped material its stable time step through the CFL formula.
+/// A Kelvin-Voigt stress beta C : D damps a mode of frequency omega at zeta = beta omega / 2; the
+/// grid's highest, omega_max = 2c/h (lumped linear elements), at zeta = beta c / h. The step
+/// (the viscous stress from the last step's velocity gradient) is stable for one mode
+/// u'' + 2 zeta omega u' + omega^2 u = 0 while omega dt <= 2 (sqrt(1 + zeta^2) - zeta), the
+/// standard bound for central differences with damping: the undamped limit h / c shrinks by
+/// sqrt(1 + zeta^2) - zeta, i.e. the signal speed grows by sqrt(1 + zeta^2) + zeta.
+inline double damped_signal_speed(double c, double beta, double h) {
+  if (!(beta > 0.0)) return c;
+  const double zeta = beta * c / h;
+  return c * (std::sqrt(1.0 + zeta * zeta) + zeta);
+}
 
 /// Registry entry data beyond the factory: the model's own keys (besides name, model, density).
 struct MaterialModelInfo {

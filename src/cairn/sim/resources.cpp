@@ -334,7 +334,8 @@ void check_run_length(const Simulation<D>& sim) {
     double v = 0.0;
     for (std::size_t p = 0; p < ps.n(); ++p) {
       const auto m = static_cast<std::size_t>(ps.material[p]);
-      c[m] = std::max(c[m], sim.materials()[m]->wave_speed(ps.deformation_gradient[p]));
+      c[m] = std::max(c[m], damped_signal_speed(sim.materials()[m]->wave_speed(ps.deformation_gradient[p]),
+                                                sim.materials()[m]->damping_time(), sim.grid().min_cell_size()));
       v = std::max(v, ps.velocity[p].norm());
     }
     // Over every rank's particles (the same message on every rank).
@@ -350,6 +351,9 @@ void check_run_length(const Simulation<D>& sim) {
       const MaterialConfig& m = config.materials[fastest];
       cause = fmt::format("material '{}' ({}) sets it: wave speed {:.6g} (with cfl {:.6g}, cell size {:.6g})",
                           m.name, m.where.str(), c[fastest], s.cfl, sim.grid().min_cell_size());
+      if (sim.materials()[fastest]->damping_time() > 0.0)
+        cause += " (the signal speed of its damping_time: the wave speed times sqrt(1 + zeta^2) + zeta, "
+                 "zeta = damping_time c / h)";
     } else {
       cause = fmt::format("the initial particle speed {:.6g} sets it (bodies' velocity)", v);
     }

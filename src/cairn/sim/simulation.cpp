@@ -31,6 +31,14 @@ template <int D>
 Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(config), mode_(config.simulation.mode) {
   if (config_.simulation.threads > 0) omp_set_num_threads(config_.simulation.threads);
   for (const auto& mc : config_.materials) materials_.push_back(make_material(mc));
+  for (const auto& m : materials_) {
+    // The plane-stress solve calls the model several times per step (materials/plane_stress.hpp),
+    // which would count a viscous stress's work more than once.
+    if (mode_ == Mode::plane_stress && m->damping_time() > 0.0)
+      throw std::invalid_argument("material '" + m->name() + "': damping_time is not available in plane stress "
+                                  "(simulation.mode = \"plane_stress\"); use plane strain or 3D");
+    damping_time_.push_back(m->damping_time());
+  }
   ShapeContext ctx{config_.method, D};
   shape_ = make_shape_family<D>(ctx);
   scheme_ = SchemeRegistry<D>::instance().create("update scheme", config_.method.update, config_.method);
@@ -413,6 +421,20 @@ double Simulation<D>::contact_dissipated_energy() const {
 }
 
 template <int D>
+double Simulation<D>::material_dissipated_energy() const {
+  if (std::none_of(damping_time_.begin(), damping_time_.end(), [](double b) { return b > 0.0; })) return 0.0;
+  // Exact sums over the owned particles and the ranks, like totals().
+  const auto& P = particles_;
+  const auto n = static_cast<std::int64_t>(n_owned());
+  std::array<ExactSum, 1> sum = detail::exact_sums<1>(n, [&](std::int64_t p, std::array<double, 1>& v) {
+    const double* state = P.n_state_per_particle ? &P.state[p * static_cast<std::size_t>(P.n_state_per_particle)] : nullptr;
+    v[0] = P.volume0[p] * materials_[P.material[p]]->dissipated_energy_density(state);
+  });
+  sum_across(distribution_.comm(), sum.data(), 1);
+  return sum[0].value();
+}
+
+template <int D>
 void Simulation<D>::restore_counters(double time, long long step, double external_work, double update_dissipated,
                                      double contact_dissipated, double next_full_mass_time) {
   time_ = time;
@@ -490,8 +512,11 @@ double Simulation<D>::max_signal_speed() const {
   const auto n_materials = static_cast<std::int32_t>(materials_.size());
   double c_max = 0.0;
   const char* varies = wave_speed_varies_.data();  // set up once, not per step
+  const double* beta = damping_time_.data();
+  const double h = grid_.min_cell_size();
   for (std::int32_t m = 0; m < n_materials; ++m)
-    if (!varies[m] && material_in_use_[m]) c_max = std::max(c_max, materials_[m]->wave_speed(Mat3::Identity()));
+    if (!varies[m] && material_in_use_[m])
+      c_max = std::max(c_max, damped_signal_speed(materials_[m]->wave_speed(Mat3::Identity()), beta[m], h));
   double v2_max = 0.0;
 #pragma omp parallel reduction(max : c_max, v2_max) if (n >= particle_loop_min)
   {
@@ -499,7 +524,9 @@ double Simulation<D>::max_signal_speed() const {
     const auto [first, last] = static_range(n, omp_get_thread_num(), omp_get_num_threads());
     for (std::int64_t p = first; p < last; ++p) {
       const std::int32_t m = particles_.material[p];
-      if (varies[m]) c_max = std::max(c_max, materials_[m]->wave_speed(particles_.deformation_gradient[p]));
+      if (varies[m])
+        c_max = std::max(c_max, damped_signal_speed(materials_[m]->wave_speed(particles_.deformation_gradient[p]),
+                                                    beta[m], h));
       v2_max = std::max(v2_max, particles_.velocity[p].squaredNorm());
     }
   }
@@ -515,7 +542,9 @@ double Simulation<D>::next_dt() const {
   if (dt <= 0.0 && s.time_step == "nominal") {
     // seed 001 Eq. 35: the wave speed of the undeformed materials, no particle speed.
     double c_max = 0.0;
-    for (const auto& m : materials_) c_max = std::max(c_max, m->wave_speed(Mat3::Identity()));
+    for (std::size_t m = 0; m < materials_.size(); ++m)
+      c_max = std::max(c_max, damped_signal_speed(materials_[m]->wave_speed(Mat3::Identity()), damping_time_[m],
+                                                  grid_.min_cell_size()));
     dt = s.cfl * grid_.min_cell_size() / c_max;
     if (conduction_) dt = std::min(dt, s.cfl * conduction_->stable_dt(particles_, material_density_));
   } else if (dt <= 0.0) {

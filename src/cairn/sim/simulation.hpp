@@ -139,9 +139,14 @@ class Simulation {
   [[nodiscard]] long long step_count() const { return step_; }
   /// Work done on the particles by body forces and velocity conditions so far.
   [[nodiscard]] double external_work() const { return external_work_; }
-  /// Energy dissipated so far: by the particle update (seed 002 Eq. 1.47-1.50) and by contact
-  /// corrections (friction and impact losses, Contact::dissipated).
-  [[nodiscard]] double dissipated_energy() const { return dissipated_energy_ + contact_dissipated_energy(); }
+  /// Energy dissipated so far: by the particle update (seed 002 Eq. 1.47-1.50), by contact
+  /// corrections (friction and impact losses, Contact::dissipated) and by damped materials.
+  [[nodiscard]] double dissipated_energy() const {
+    return dissipated_energy_ + contact_dissipated_energy() + material_dissipated_energy();
+  }
+  /// The materials' part of dissipated_energy(): the work of their viscous stresses
+  /// (Material::dissipated_energy_density, kept per particle; 0 when no material is damped).
+  [[nodiscard]] double material_dissipated_energy() const;
   /// The particle update's part of dissipated_energy().
   [[nodiscard]] double update_dissipated_energy() const { return dissipated_energy_; }
   /// The contact corrections' part of dissipated_energy() (0 without contact).
@@ -299,6 +304,7 @@ class Simulation {
   std::vector<double> material_density_;  ///< periodic FMPM/XPIC: the steps between full-mass ones
   std::vector<char> material_in_use_;     ///< whether any particle has material m
   std::vector<char> wave_speed_varies_;   ///< Material::wave_speed_varies of material m
+  std::vector<double> damping_time_;      ///< Material::damping_time of material m
   const StressTiming* timing_ = nullptr;  ///< method.stress_update (sim/stress_timing.hpp)
   /// The features attached to the step's named points (StepPoint), in attachment order.
   std::array<std::vector<std::function<void(double dt)>>, 5> hooks_;
