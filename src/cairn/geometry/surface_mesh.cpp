@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -78,6 +79,33 @@ void check_stl_size(const std::string& path, std::uintmax_t size) {
     fail(path, fmt::format("a binary STL whose header counts {} triangles (84 + 50 x {} = {} bytes) but the "
                            "file has {} bytes ({})",
                            n, n, expected, size, size < expected ? "truncated" : "extra bytes or a wrong count"));
+}
+
+/// The header of a PLY file, before CGAL reads it: CGAL 5.5's PLY reader adds a `property` to
+/// the last `element` declared, and one declared before any element is a write through an empty
+/// vector (a crash). Refuses a header without `end_header`, a line of another keyword, a
+/// property before the first element.
+void check_ply_header(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  bool element = false;
+  for (int number = 1; std::getline(in, line) && number <= 100000; ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (number == 1) {
+      if (keyword != "ply") fail(path, "a PLY file that does not start with 'ply'");
+      continue;
+    }
+    if (keyword == "end_header") return;
+    if (keyword == "element") element = true;
+    else if (keyword == "property" && !element)
+      fail(path, fmt::format("PLY header line {}: a property before any element", number));
+    else if (keyword != "property" && keyword != "format" && keyword != "comment" && keyword != "obj_info")
+      fail(path, fmt::format("PLY header line {}: '{}' is no PLY header keyword", number, keyword));
+  }
+  fail(path, "a PLY header without 'end_header'");
 }
 
 /// Faults of the polygon soup (file order, file coordinates): repeated vertices and zero areas,
@@ -188,6 +216,7 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off")
     fail(path, fmt::format("extension '{}' is none of .stl, .obj, .ply, .off", ext));
   if (ext == ".stl") check_stl_size(path, size);
+  if (ext == ".ply") check_ply_header(path);
 
   std::vector<Point> points;
   std::vector<Polygon> polygons;
