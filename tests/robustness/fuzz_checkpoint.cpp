@@ -488,6 +488,10 @@ int exercise(const std::string& input, std::string& what) {
                                               "output.snapshots=false", "output.checkpoints=false",
                                               "output.directory=\"" + (scratch / "out").string() + "\""};
   auto names_file = [&](const std::string& text) {
+    if (fuzz::out_of_memory(text)) {
+      what = "an allocation the file does not justify: " + text;
+      return -1;
+    }
     if (text.find(file.string()) != std::string::npos) return 0;
     what = "an input error that does not name the checkpoint file: " + text;
     return -1;
@@ -583,6 +587,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   fuzz::catch_crashes();
+  fuzz::limit_memory(std::size_t{8} << 30);
   fuzz::Findings findings;
   std::string what;
   // The seeds restore and step.

@@ -81,6 +81,10 @@ int exercise(const std::string& input, std::string& what) {
   spill(file, bytes);
   const std::string path = file.string();
   auto names_file = [&](const std::string& text) {
+    if (fuzz::out_of_memory(text)) {
+      what = "an allocation the file does not justify: " + text;
+      return -1;
+    }
     if (text.find(path) != std::string::npos) return 0;
     what = "an input error that does not name the file: " + text;
     return -1;
@@ -273,6 +277,7 @@ int main(int argc, char** argv) {
   }
   fuzz::make_scratch("fuzz_geometry");
   fuzz::catch_crashes();
+  fuzz::limit_memory(std::size_t{8} << 30);
   fuzz::Findings findings;
   std::vector<std::string> seeds;
   std::string what;

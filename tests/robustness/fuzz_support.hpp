@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace fuzz {
@@ -49,6 +50,33 @@ inline void make_scratch(const char* name) {
   }
   scratch = tmpl;
   crash_path = (scratch / "crash.bin").string();
+}
+
+/// At most `bytes` of address space for this process (not under AddressSanitizer, which reserves
+/// far more for its shadow memory): a reader that sizes its arrays by a damaged count then gets
+/// std::bad_alloc at once instead of taking the machine's memory.
+#if defined(__SANITIZE_ADDRESS__)
+#define CAIRN_FUZZ_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CAIRN_FUZZ_ASAN 1
+#endif
+#endif
+inline void limit_memory(std::size_t bytes) {
+#ifndef CAIRN_FUZZ_ASAN
+  const rlimit limit{bytes, bytes};
+  ::setrlimit(RLIMIT_AS, &limit);
+#else
+  (void)bytes;
+#endif
+}
+
+/// Whether an input error's text says that the reader ran out of memory: an allocation the
+/// file's size does not justify (a damaged count) is a finding even when the reader turns it
+/// into an input error.
+inline bool out_of_memory(const std::string& text) {
+  return text.find("bad_alloc") != std::string::npos || text.find("bad array new length") != std::string::npos ||
+         text.find("_M_default_append") != std::string::npos || text.find("length_error") != std::string::npos;
 }
 
 /// A finding's message without its numbers and quoted names, to tell different findings apart.

@@ -101,11 +101,19 @@ class Bytes {
 /// that does not end, is an input error (`fail`) instead of the end of the run, and the parent's
 /// Gmsh state is never touched by a reading. Errors the reading throws come back with their kind
 /// (InputError, std::invalid_argument, other).
-Bytes in_child(const std::function<void(Bytes&)>& read, const std::function<void(const std::string&)>& fail) {
+Bytes in_child(const std::string& path, const std::function<void(Bytes&)>& read,
+               const std::function<void(const std::string&)>& fail) {
   (void)gmsh();  // loaded here, once, not in every child
   constexpr int timeout_seconds = 300;
+  // The child may take 1 GiB and 200 bytes per byte of the file beyond what it starts with: a
+  // count in a damaged file (a node count of 2^31 in a file of 400 bytes) makes Gmsh's
+  // allocation fail there instead of taking the machine's memory.
+  std::error_code ec;
+  const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
+  const double budget = (1u << 30) + 200.0 * (ec ? 0.0 : file_bytes);
   const ChildResult r = run_in_child(
       [&](std::string& out) {
+        limit_address_space(budget);
         Bytes answer;
         try {
           answer.put<char>('0');
@@ -140,14 +148,22 @@ Bytes in_child(const std::function<void(Bytes&)>& read, const std::function<void
   Bytes in;
   in.data() = r.output;
   const char kind = in.get<char>();
+  const std::string memory = fmt::format("Gmsh ran out of the {:.3g} GiB a mesh file of {:.0f} bytes may take: a count "
+                                         "in the file larger than its content",
+                                         budget / (1u << 30), file_bytes);
   if (kind == 'I') {
     std::string file = in.get_string();
     const int line = in.get<int>();
     std::string key = in.get_string(), expected = in.get_string(), found = in.get_string();
+    if (found.find("bad_alloc") != std::string::npos) found = memory;
     throw InputError(std::move(file), line, std::move(key), std::move(expected), std::move(found));
   }
-  if (kind == 'A') throw std::invalid_argument(in.get_string());
-  if (kind == 'R') throw std::runtime_error(in.get_string());
+  if (kind == 'A' || kind == 'R') {
+    const std::string what = in.get_string();
+    if (what.find("bad_alloc") != std::string::npos) fail(memory);
+    if (kind == 'A') throw std::invalid_argument(what);
+    throw std::runtime_error(what);
+  }
   return in;
 }
 
@@ -163,6 +179,7 @@ TriangleMesh read_gmsh_file(const std::string& path) {
   if (!std::filesystem::is_regular_file(path))
     throw InputError(path, 0, "fem.mesh_file", "a readable Gmsh .msh file", "no such file");
   Bytes answer = in_child(
+      path,
       [&](Bytes& out) {
         const TriangleMesh read = gmsh().read_file(path);
         out.put_vector(read.nodes);
@@ -188,6 +205,7 @@ TriangleMesh read_gmsh_file(const std::string& path) {
 ElementMesh read_gmsh_elements(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::invalid_argument("no such file");
   Bytes answer = in_child(
+      path,
       [&](Bytes& out) {
         const ElementMesh read = gmsh().read_elements(path);
         out.put_vector(read.nodes);

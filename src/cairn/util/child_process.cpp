@@ -2,6 +2,7 @@
 
 #include <poll.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 namespace cairn {
@@ -68,6 +70,26 @@ ChildResult run_in_child(const std::function<int(std::string& out)>& work, int t
   if (WIFSIGNALED(status) && !result.timed_out) result.signal = WTERMSIG(status);
   if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
   return result;
+}
+
+void limit_address_space(double bytes) {
+#if defined(__SANITIZE_ADDRESS__)
+#define CAIRN_CHILD_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define CAIRN_CHILD_ASAN 1
+#endif
+#endif
+#ifdef CAIRN_CHILD_ASAN
+  (void)bytes;
+#else
+  std::ifstream statm("/proc/self/statm");
+  double pages = 0.0;
+  statm >> pages;
+  const double limit = pages * static_cast<double>(::sysconf(_SC_PAGESIZE)) + bytes;
+  const rlimit r{static_cast<rlim_t>(limit), static_cast<rlim_t>(limit)};
+  ::setrlimit(RLIMIT_AS, &r);
+#endif
 }
 
 }  // namespace cairn

@@ -25,4 +25,10 @@ struct ChildResult {
 /// `work` returns as a crash. Throws std::runtime_error when no process can be started.
 ChildResult run_in_child(const std::function<int(std::string& out)>& work, int timeout_seconds);
 
+/// In a child: at most `bytes` more address space than the process has now (RLIMIT_AS), so that
+/// an allocation sized by a damaged count fails (std::bad_alloc) instead of taking the machine's
+/// memory. Under AddressSanitizer, whose own reservations are far larger, it does nothing (the
+/// sanitizer reports such allocations itself).
+void limit_address_space(double bytes);
+
 }  // namespace cairn
