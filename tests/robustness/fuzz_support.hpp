@@ -75,8 +75,16 @@ inline void limit_memory(std::size_t bytes) {
 /// file's size does not justify (a damaged count) is a finding even when the reader turns it
 /// into an input error.
 inline bool out_of_memory(const std::string& text) {
-  return text.find("bad_alloc") != std::string::npos || text.find("bad array new length") != std::string::npos ||
-         text.find("_M_default_append") != std::string::npos || text.find("length_error") != std::string::npos;
+  // Outside the quoted parts: a message quotes the file's own text, which may say anything.
+  std::string own;
+  bool quoted = false;
+  for (char c : text) {
+    if (c == '\'') quoted = !quoted;
+    else if (!quoted) own += c;
+  }
+  return own.find("std::bad_alloc") != std::string::npos || own.find("bad_array_new_length") != std::string::npos ||
+         own.find("vector::_M_default_append") != std::string::npos ||
+         own.find("cannot create std::vector larger than max_size()") != std::string::npos;
 }
 
 /// A finding's message without its numbers and quoted names, to tell different findings apart.
