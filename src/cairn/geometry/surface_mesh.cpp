@@ -1,6 +1,7 @@
 // Surface meshes as body shapes: reading and checking through CGAL 5.5, the line-by-line inside
 // test (surface_mesh.hpp). This is the only translation unit that includes CGAL.
 #include "cairn/geometry/surface_mesh.hpp"
+#include "cairn/util/child_process.hpp"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -364,9 +365,26 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
     return c;
   };
   for (auto f : faces(mesh)) before.push_back(corners(f));
-  PMP::orient_to_bound_a_volume(mesh);
-  std::size_t flipped = 0;
-  for (auto f : faces(mesh)) flipped += corners(f) != before[f.idx()];
+  // CGAL 5.5's orient_to_bound_a_volume reads freed memory on some nearly degenerate surfaces
+  // (an OBJ cube with two corners 1e-16 apart, found by cairn_fuzz_geometry): it runs on a child
+  // process's copy of the mesh, which sends back which faces it turned, and a crash there is an
+  // input error; the turns are made here.
+  const ChildResult oriented = run_in_child(
+      [&](std::string& answer) {
+        PMP::orient_to_bound_a_volume(mesh);
+        for (auto f : faces(mesh)) answer.push_back(corners(f) != before[f.idx()] ? '1' : '0');
+        return 0;
+      },
+      300);
+  if (oriented.signal != 0 || oriented.timed_out || oriented.exit_code != 0 ||
+      oriented.output.size() != mesh.number_of_faces())
+    fail(path, "CGAL failed to orient the surface to bound a volume (a nearly degenerate surface: corners or faces "
+               "almost on each other?)");
+  std::vector<Mesh::Face_index> to_turn;
+  for (auto f : faces(mesh))
+    if (oriented.output[f.idx()] == '1') to_turn.push_back(f);
+  PMP::reverse_face_orientations(to_turn, mesh);
+  const std::size_t flipped = to_turn.size();
   if (turned > 0)
     out.warnings_.push_back(fmt::format("surface mesh '{}': {} edges joined faces of opposite orientation; {} faces "
                                         "turned to agree with their neighbours",
