@@ -484,8 +484,12 @@ CheckpointData<D> read_checkpoint(const fs::path& path, const Comm& comm) {
     where = "/particles/state";
     ps.state = h5::read_doubles_rows(gid, "state", first * width, n * width);
   });
-  check_values(path, data, first);
   return data;
+}
+
+template <int D>
+void check_checkpoint_values(const fs::path& path, const CheckpointData<D>& data, std::size_t first_row) {
+  check_values(path, data, first_row);
 }
 
 int checkpoint_dimension(const fs::path& path) {
@@ -575,6 +579,9 @@ template void write_checkpoint<3>(const fs::path&, const CheckpointData<3>&, con
 template CheckpointData<1> read_checkpoint<1>(const fs::path&, const Comm&);
 template CheckpointData<2> read_checkpoint<2>(const fs::path&, const Comm&);
 template CheckpointData<3> read_checkpoint<3>(const fs::path&, const Comm&);
+template void check_checkpoint_values<1>(const fs::path&, const CheckpointData<1>&, std::size_t);
+template void check_checkpoint_values<2>(const fs::path&, const CheckpointData<2>&, std::size_t);
+template void check_checkpoint_values<3>(const fs::path&, const CheckpointData<3>&, std::size_t);
 template CheckpointData<1> read_checkpoint<1>(const fs::path&);
 template CheckpointData<2> read_checkpoint<2>(const fs::path&);
 template CheckpointData<3> read_checkpoint<3>(const fs::path&);

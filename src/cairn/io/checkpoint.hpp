@@ -72,12 +72,20 @@ void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>
                       const Particles<D>& particles, const Comm& comm);
 /// Read a checkpoint written by write_checkpoint<D>. Throws InputError (exit 2) naming the file
 /// and the attribute or dataset when the file is missing, not HDF5, not a Cairn checkpoint, of
-/// another format version or dimension, damaged (its checksum), or holds what no run writes: a
-/// missing dataset, one of another shape or type, a particle dataset of another length than
-/// /particles/mass, a value that is not finite, a negative mass or volume, a deformation gradient
-/// with a determinant <= 0, a negative index (docs/robustness.md, "Files from outside").
+/// another format version or dimension, damaged (its checksum), or holds what this format does
+/// not: a missing dataset, one of another shape or type, a particle dataset of another length
+/// than /particles/mass, shapes larger than the file (docs/robustness.md, "Files from outside").
+/// The values are read as they are; check_checkpoint_values() says whether a run wrote them.
 template <int D>
 CheckpointData<D> read_checkpoint(const std::filesystem::path& path);
+
+/// Whether `data` (rows from `first_row` of the file `path`) holds values a run could have
+/// written: finite, masses, volumes and sizes not below zero, deformation gradients with a
+/// positive determinant, indices not negative, time, step and indices in range; InputError naming
+/// the object otherwise. The restart calls it (run/mpm_engine.cpp); read_checkpoint does not, so
+/// that any data round-trips.
+template <int D>
+void check_checkpoint_values(const std::filesystem::path& path, const CheckpointData<D>& data, std::size_t first_row);
 
 /// The same on each rank of `comm`: everything but the particles, and an equal share of the
 /// particle rows (any share: the run redistributes them; the file may come from any number of

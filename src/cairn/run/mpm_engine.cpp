@@ -604,6 +604,24 @@ std::unique_ptr<Engine> create(const Config& config, const std::string& name) {
 template <int D>
 std::unique_ptr<Engine> restore_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
+  // Values no run writes stop every rank with the first bad rank's message (row numbers count
+  // from this rank's first row).
+  {
+    const Comm world = Comm::world();
+    std::string problem;
+    try {
+      check_checkpoint_values<D>(file, data, 0);
+    } catch (const InputError& e) {
+      if (!world.parallel()) throw;
+      problem = e.what();
+    }
+    const std::int64_t first_bad =
+        world.min(problem.empty() ? std::int64_t{world.size()} : std::int64_t{world.rank()});
+    if (first_bad < world.size()) {
+      world.broadcast(problem, static_cast<int>(first_bad));
+      throw std::invalid_argument(problem);
+    }
+  }
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   // (--set cannot change the dimension or the engine: restore_engine refuses those keys.)
   if (config.simulation.dimension != D)
