@@ -604,13 +604,14 @@ std::unique_ptr<Engine> create(const Config& config, const std::string& name) {
 template <int D>
 std::unique_ptr<Engine> restore_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
-  // Values no run writes stop every rank with the first bad rank's message (row numbers count
-  // from this rank's first row).
+  // Values no run writes stop every rank with the first bad rank's message (each rank read the
+  // rows after those of the ranks before it).
   {
     const Comm world = Comm::world();
+    const auto first_row = static_cast<std::size_t>(world.exclusive_prefix(static_cast<std::int64_t>(data.particles.n())));
     std::string problem;
     try {
-      check_checkpoint_values<D>(file, data, 0);
+      check_checkpoint_values<D>(file, data, first_row);
     } catch (const InputError& e) {
       if (!world.parallel()) throw;
       problem = e.what();
