@@ -27,6 +27,7 @@
 #include <boost/function_output_iterator.hpp>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -286,13 +287,71 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
   if (ext == ".ply") check_ply_header(path, size);
   if (ext == ".off") check_off_counts(path, size);
 
+  // CGAL's readers run in a child process, which sends back the points and faces: CGAL 5.5's
+  // PLY reader dereferences a null property on some damaged headers (found by
+  // cairn_fuzz_geometry), and the child may take 1 GiB and 200 bytes per byte of the file, so
+  // that a count sizing its arrays fails there; a crash or a failure there is an input error.
   std::vector<Point> points;
   std::vector<Polygon> polygons;
   bool read = false;
-  try {
-    read = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    fail(path, fmt::format("CGAL's {} reader failed: {}", ext.substr(1), e.what()));
+  const ChildResult soup = run_in_child(
+      [&](std::string& out) {
+        limit_address_space((1u << 30) + 200.0 * static_cast<double>(size));
+        std::string error;
+        bool ok = false;
+        try {
+          ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
+        } catch (const std::exception& e) {
+          error = e.what();
+        }
+        auto put = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+        const std::uint64_t flags[3] = {ok ? 1u : 0u, points.size(), polygons.size()};
+        put(flags, sizeof flags);
+        for (const Point& p : points) {
+          const double x[3] = {p.x(), p.y(), p.z()};
+          put(x, sizeof x);
+        }
+        for (const Polygon& q : polygons) {
+          const std::uint64_t n = q.size();
+          put(&n, sizeof n);
+          put(q.data(), q.size() * sizeof(std::size_t));
+        }
+        out += error;
+        return 0;
+      },
+      300);
+  if (soup.signal != 0 || soup.timed_out || soup.exit_code != 0 || soup.output.size() < 24)
+    fail(path, fmt::format("CGAL's {} reader failed on it ({}): a damaged file", ext.substr(1),
+                           soup.timed_out ? "it did not finish in 300 s"
+                           : soup.signal != 0 ? fmt::format("signal {}", soup.signal)
+                                              : fmt::format("exit code {}", soup.exit_code)));
+  {
+    std::size_t at = 0;
+    auto take = [&](void* p, std::size_t n) {
+      if (at + n > soup.output.size()) fail(path, "CGAL's reader process sent a short answer");
+      std::memcpy(p, soup.output.data() + at, n);
+      at += n;
+    };
+    std::uint64_t flags[3];
+    take(flags, sizeof flags);
+    read = flags[0] == 1;
+    points.reserve(flags[1]);
+    for (std::uint64_t i = 0; i < flags[1]; ++i) {
+      double x[3];
+      take(x, sizeof x);
+      points.emplace_back(x[0], x[1], x[2]);
+    }
+    polygons.reserve(flags[2]);
+    for (std::uint64_t i = 0; i < flags[2]; ++i) {
+      std::uint64_t n = 0;
+      take(&n, sizeof n);
+      if (n > soup.output.size()) fail(path, "CGAL's reader process sent a bad answer");
+      Polygon q(n);
+      take(q.data(), n * sizeof(std::size_t));
+      polygons.push_back(std::move(q));
+    }
+    const std::string error = soup.output.substr(at);
+    if (!error.empty()) fail(path, fmt::format("CGAL's {} reader failed: {}", ext.substr(1), error));
   }
   if (!read)
     fail(path, fmt::format("CGAL's {} reader could not read it (malformed or truncated: {} vertices and {} faces "
