@@ -32,6 +32,8 @@
 #include <typeinfo>
 #include <vector>
 
+#include <hdf5.h>
+
 #include "cairn/config/errors.hpp"
 #include "cairn/geometry/outline.hpp"
 #include "cairn/geometry/point_set.hpp"
@@ -74,8 +76,24 @@ std::pair<std::size_t, std::string> split(const std::string& input) {
   return {static_cast<std::uint8_t>(input[0]) % formats.size(), input.substr(1)};
 }
 
+/// -1 (with `what`) when a reading left an HDF5 file or object open (HDF5 point files): its
+/// memory stays taken to the end of the process.
+int left_open(std::string& what) {
+  const ssize_t open = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL);
+  if (open <= 0) return 0;
+  what = "the reading left " + std::to_string(open) + " HDF5 objects open";
+  return -1;
+}
+
+int read_one(const std::string& input, std::string& what);
+
 /// 1: read; 0: an input error naming the file; -1 (with `what`): anything else.
 int exercise(const std::string& input, std::string& what) {
+  const int outcome = read_one(input, what);
+  return outcome < 0 ? outcome : left_open(what) < 0 ? -1 : outcome;
+}
+
+int read_one(const std::string& input, std::string& what) {
   const auto [f, bytes] = split(input);
   const fs::path file = scratch / (std::string("fuzz") + formats[f].extension);
   spill(file, bytes);
