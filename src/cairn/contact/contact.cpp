@@ -488,7 +488,7 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       in.dt = dt;
       in.time = time;
       const ContactLaw& L = *laws_[static_cast<std::size_t>(law)];
-      using S = NodeTrace::State;
+      using S = typename NodeTrace::State;
       auto traced = [&](S state, const Vec3& d) {
         if (tracing) trace_.push_back({node, it.a, it.b, state, it.normal, it.separation, it.area, in.dp0, d});
         return d;

@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
+#include "cairn/config/errors.hpp"
 #include "cairn/io/atomic_file.hpp"
 #include "cairn/io/hdf5_util.hpp"
 #include "cairn/math/tensor.hpp"
@@ -220,39 +223,100 @@ bool is_checkpoint(const fs::path& path) {
 }
 
 Checkpoint read_checkpoint(const fs::path& path) {
-  if (!is_checkpoint(path)) throw std::runtime_error("'" + path.string() + "' is not a Cairn FEM checkpoint");
-  h5::Handle file = h5::open_file(path);
-  const hid_t root = file.get();
+  // Whatever is wrong is exit 2 naming the file and the object (docs/robustness.md, "Files from outside").
+  auto refuse = [&](const std::string& object, const std::string& expected, const std::string& found) {
+    throw InputError(path.string(), 0, object, expected, found);
+  };
+  if (!is_checkpoint(path)) {
+    std::string format = "none";
+    try {
+      h5::Handle file = h5::open_file(path);
+      if (h5::has_attribute(file.get(), "format")) format = "'" + h5::read_string_attribute(file.get(), "format") + "'";
+    } catch (const std::exception&) {
+      format = "unreadable";
+    }
+    refuse("format", std::string("'") + checkpoint_format + "', the format of the engine its 'engine' attribute names (fem)",
+           format + " (a damaged or edited checkpoint)");
+  }
   Checkpoint d;
-  d.config_toml = h5::read_text(root, "input");
-  const auto names = h5::read_text_list(root, "scalar_names");
-  const auto values = h5::read_doubles(root, "scalar_values", {names.size()});
-  for (std::size_t k = 0; k < names.size(); ++k) d.scalars[names[k]] = values[k];
-  auto& s = d.state;
-  s.time = d.scalars.at("time");
-  s.external_work = d.scalars.at("external_work");
-  s.step = static_cast<long long>(d.scalars.at("step"));
-  s.error_now = d.scalars.at("displacement_error");
-  s.error_max = d.scalars.at("displacement_error_max");
-  const auto read = [&](const std::string& name) { return h5::read_doubles(root, name, h5::dataset_shape(root, name)); };
-  s.x = unflat2(read("x"));
-  s.v = unflat2(read("v"));
-  s.a = unflat2(read("a"));
-  s.b = unflat2(read("b"));
-  s.reaction = unflat2(read("reaction"));
-  s.F = unflat9(read("F"));
-  s.tau = unflat9(read("tau"));
-  s.element_state = read("element_state");
-  s.temperature = read("temperature");
-  d.history_columns = h5::read_text_list(root, "history_columns");
-  const auto rows = read("history_rows");
-  const std::size_t nc = d.history_columns.size();
-  for (std::size_t r = 0; nc > 0 && r < rows.size() / nc; ++r)
-    d.history_rows.emplace_back(rows.begin() + static_cast<std::ptrdiff_t>(r * nc),
-                                rows.begin() + static_cast<std::ptrdiff_t>((r + 1) * nc));
-  const auto times = read("snapshot_times");
-  const auto files = h5::read_text_list(root, "snapshot_files");
-  for (std::size_t k = 0; k < times.size() && k < files.size(); ++k) d.snapshots.emplace_back(times[k], files[k]);
+  std::string where = "/";
+  try {
+    h5::Handle file = h5::open_file(path);
+    const hid_t root = file.get();
+    where = "/input";
+    d.config_toml = h5::read_text(root, "input");
+    where = "/scalar_names";
+    const auto names = h5::read_text_list(root, "scalar_names");
+    where = "/scalar_values";
+    const auto values = h5::read_doubles(root, "scalar_values", {names.size()});
+    for (std::size_t k = 0; k < names.size(); ++k) d.scalars[names[k]] = values[k];
+    for (const auto& [name, value] : d.scalars)
+      if (!std::isfinite(value)) refuse("/scalar_values (" + name + ")", "finite run-loop scalars", fmt::format("{}", value));
+    auto scalar = [&](const char* name) {
+      const auto it = d.scalars.find(name);
+      if (it == d.scalars.end())
+        refuse("/scalar_names", fmt::format("the run-loop scalar '{}'", name), "a list without it (a damaged or edited checkpoint)");
+      return it->second;
+    };
+    auto& s = d.state;
+    s.time = scalar("time");
+    s.external_work = scalar("external_work");
+    const double step = scalar("step");
+    if (!(step >= 0.0 && step <= 9e15)) refuse("/scalar_values (step)", "a step count 0..9e15", fmt::format("{}", step));
+    s.step = static_cast<long long>(step);
+    s.error_now = scalar("displacement_error");
+    s.error_max = scalar("displacement_error_max");
+    for (const char* name : {"initial_energy", "previous_dt", "checkpoint_index", "snapshots_done", "history_done",
+                             "checkpoints_done"}) {
+      const double v = scalar(name);
+      if (std::string(name).find("_done") != std::string::npos || std::string(name) == "checkpoint_index")
+        if (!(v >= 0.0 && v <= 1e9)) refuse(std::string("/scalar_values (") + name + ")", "a count 0..1e9", fmt::format("{}", v));
+    }
+    // n x cols doubles, every one finite.
+    auto read = [&](const std::string& name, std::size_t cols) {
+      where = "/" + name;
+      const std::vector<std::size_t> shape = h5::dataset_shape(root, name);
+      if (cols > 0 ? shape.size() != 2 || shape[1] != cols : shape.size() != 1)
+        refuse(where, cols > 0 ? fmt::format("an n x {} dataset", cols) : std::string("a 1D dataset"),
+               fmt::format("{} axes{}", shape.size(), shape.size() == 2 ? fmt::format(" of {} columns", shape[1]) : ""));
+      const std::vector<double> v = h5::read_doubles(root, name, shape);
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (!std::isfinite(v[i])) refuse(fmt::format("{}[{}]", where, i / std::max<std::size_t>(cols, 1)), "finite values", fmt::format("{}", v[i]));
+      return v;
+    };
+    s.x = unflat2(read("x", 2));
+    s.v = unflat2(read("v", 2));
+    s.a = unflat2(read("a", 2));
+    s.b = unflat2(read("b", 2));
+    s.reaction = unflat2(read("reaction", 2));
+    s.F = unflat9(read("F", 9));
+    for (std::size_t e = 0; e < s.F.size(); ++e)
+      if (!(s.F[e].determinant() > 0.0)) refuse(fmt::format("/F[{}]", e), "a deformation gradient with a positive determinant", "one <= 0");
+    s.tau = unflat9(read("tau", 9));
+    s.element_state = read("element_state", 0);
+    s.temperature = read("temperature", 0);
+    where = "/history_columns";
+    d.history_columns = h5::read_text_list(root, "history_columns");
+    where = "/history_rows";
+    const auto shape = h5::dataset_shape(root, "history_rows");
+    if (shape.size() != 2 || shape[1] != d.history_columns.size())
+      refuse(where, fmt::format("rows x {} columns, as /history_columns lists", d.history_columns.size()),
+             fmt::format("{} axes{}", shape.size(), shape.size() == 2 ? fmt::format(" of {} columns", shape[1]) : ""));
+    const auto rows = h5::read_doubles(root, "history_rows", shape);
+    const std::size_t nc = d.history_columns.size();
+    for (std::size_t r = 0; nc > 0 && r < rows.size() / nc; ++r)
+      d.history_rows.emplace_back(rows.begin() + static_cast<std::ptrdiff_t>(r * nc),
+                                  rows.begin() + static_cast<std::ptrdiff_t>((r + 1) * nc));
+    where = "/snapshot_files";
+    const auto files = h5::read_text_list(root, "snapshot_files");
+    where = "/snapshot_times";
+    const auto times = h5::read_doubles(root, "snapshot_times", {files.size()});
+    for (std::size_t k = 0; k < times.size() && k < files.size(); ++k) d.snapshots.emplace_back(times[k], files[k]);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // the HDF5 helpers: a missing dataset, a wrong shape or type
+    refuse(where, "the object as Cairn's FEM writes it", std::string(e.what()) + " (a damaged or edited checkpoint)");
+  }
   return d;
 }
 

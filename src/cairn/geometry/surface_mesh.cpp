@@ -1,6 +1,7 @@
 // Surface meshes as body shapes: reading and checking through CGAL 5.5, the line-by-line inside
 // test (surface_mesh.hpp). This is the only translation unit that includes CGAL.
 #include "cairn/geometry/surface_mesh.hpp"
+#include "cairn/util/child_process.hpp"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
@@ -26,9 +27,11 @@
 #include <boost/function_output_iterator.hpp>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -78,6 +81,99 @@ void check_stl_size(const std::string& path, std::uintmax_t size) {
     fail(path, fmt::format("a binary STL whose header counts {} triangles (84 + 50 x {} = {} bytes) but the "
                            "file has {} bytes ({})",
                            n, n, expected, size, size < expected ? "truncated" : "extra bytes or a wrong count"));
+}
+
+/// The header of a PLY file, before CGAL reads it: CGAL 5.5's PLY reader adds a `property` to
+/// the last `element` declared, and one declared before any element is a write through an empty
+/// vector (a crash). Refuses a header without `end_header`, a line of another keyword, a
+/// property before the first element.
+void check_ply_header(const std::string& path, std::uintmax_t size) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  bool element = false;
+  double declared = 0.0;  // elements of every kind: each takes at least one byte
+  for (int number = 1; std::getline(in, line) && number <= 100000; ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (number == 1) {
+      if (keyword != "ply") fail(path, "a PLY file that does not start with 'ply'");
+      continue;
+    }
+    if (keyword == "end_header") {
+      if (declared > static_cast<double>(size))
+        fail(path, fmt::format("a PLY header declaring {:.6g} elements in a file of {} bytes (a wrong count)", declared,
+                               size));
+      return;
+    }
+    if (keyword == "element") {
+      element = true;
+      std::string name;
+      double count = -1.0;
+      words >> name >> count;
+      if (!(count >= 0.0)) fail(path, fmt::format("PLY header line {}: an element without a count", number));
+      declared += count;
+    }
+    else if (keyword == "property" && !element)
+      fail(path, fmt::format("PLY header line {}: a property before any element", number));
+    else if (keyword != "property" && keyword != "format" && keyword != "comment" && keyword != "obj_info")
+      fail(path, fmt::format("PLY header line {}: '{}' is no PLY header keyword", number, keyword));
+  }
+  fail(path, "a PLY header without 'end_header'");
+}
+
+/// The counts of an OFF file, before CGAL reads it: CGAL 5.5 sizes its arrays by the header's
+/// counts, so "8 1200000001 0" in a 400-byte file asks for 28 GB. A vertex takes at least 6
+/// bytes ("0 0 0 "), a face at least 8 ("3 0 1 2 ") in the text form, more in the binary one.
+void check_off_counts(const std::string& path, std::uintmax_t size) {
+  std::ifstream in(path, std::ios::binary);
+  std::string word;
+  std::vector<double> counts;
+  bool header = false;
+  while (counts.size() < 2 && in >> word) {
+    if (word[0] == '#') {
+      std::getline(in, word);
+      continue;
+    }
+    if (!header) {  // OFF, COFF, NOFF, STOFF, 4OFF, nOFF ... then perhaps BINARY
+      header = true;
+      if (word.find("OFF") != std::string::npos) {
+        if (in.peek() == ' ' && in >> word) {
+          if (word == "BINARY") return;  // (binary counts: CGAL's reader, unchecked here)
+          counts.push_back(std::atof(word.c_str()));
+        }
+        continue;
+      }
+    }
+    counts.push_back(std::atof(word.c_str()));
+  }
+  if (counts.size() < 2) return;  // (CGAL reports what is missing)
+  const double bytes = 6.0 * counts[0] + 8.0 * counts[1];
+  if (!(counts[0] >= 0.0 && counts[1] >= 0.0) || bytes > static_cast<double>(size))
+    fail(path, fmt::format("an OFF header counting {:.6g} vertices and {:.6g} faces, more than its {} bytes can hold (a "
+                           "wrong count)",
+                           counts[0], counts[1], size));
+  // The faces' own vertex counts, which CGAL also sizes a polygon by: the vertex lines, then one
+  // line per face starting with its count (a face of k vertices takes at least 2 k bytes).
+  std::string line;
+  std::getline(in, line);  // the rest of the counts line
+  long long vertices = static_cast<long long>(counts[0]), faces = static_cast<long long>(counts[1]);
+  for (long long number = 0; std::getline(in, line) && faces > 0;) {
+    std::istringstream words(line);
+    std::string first;
+    if (!(words >> first) || first[0] == '#') continue;
+    if (vertices > 0) {
+      --vertices;
+      continue;
+    }
+    --faces;
+    ++number;
+    const double k = std::atof(first.c_str());
+    if (!(k >= 0.0) || 2.0 * k > static_cast<double>(size))
+      fail(path, fmt::format("face {} of the OFF file lists {:.6g} vertices, more than its {} bytes can hold", number, k,
+                             size));
+  }
 }
 
 /// Faults of the polygon soup (file order, file coordinates): repeated vertices and zero areas,
@@ -188,14 +284,74 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off")
     fail(path, fmt::format("extension '{}' is none of .stl, .obj, .ply, .off", ext));
   if (ext == ".stl") check_stl_size(path, size);
+  if (ext == ".ply") check_ply_header(path, size);
+  if (ext == ".off") check_off_counts(path, size);
 
+  // CGAL's readers run in a child process, which sends back the points and faces: CGAL 5.5's
+  // PLY reader dereferences a null property on some damaged headers (found by
+  // cairn_fuzz_geometry), and the child may take 1 GiB and 200 bytes per byte of the file, so
+  // that a count sizing its arrays fails there; a crash or a failure there is an input error.
   std::vector<Point> points;
   std::vector<Polygon> polygons;
   bool read = false;
-  try {
-    read = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    fail(path, fmt::format("CGAL's {} reader failed: {}", ext.substr(1), e.what()));
+  const ChildResult soup = run_in_child(
+      [&](std::string& out) {
+        limit_address_space((1u << 30) + 200.0 * static_cast<double>(size));
+        std::string error;
+        bool ok = false;
+        try {
+          ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
+        } catch (const std::exception& e) {
+          error = e.what();
+        }
+        auto put = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+        const std::uint64_t flags[3] = {ok ? 1u : 0u, points.size(), polygons.size()};
+        put(flags, sizeof flags);
+        for (const Point& p : points) {
+          const double x[3] = {p.x(), p.y(), p.z()};
+          put(x, sizeof x);
+        }
+        for (const Polygon& q : polygons) {
+          const std::uint64_t n = q.size();
+          put(&n, sizeof n);
+          put(q.data(), q.size() * sizeof(std::size_t));
+        }
+        out += error;
+        return 0;
+      },
+      300);
+  if (soup.signal != 0 || soup.timed_out || soup.exit_code != 0 || soup.output.size() < 24)
+    fail(path, fmt::format("CGAL's {} reader failed on it ({}): a damaged file", ext.substr(1),
+                           soup.timed_out ? "it did not finish in 300 s"
+                           : soup.signal != 0 ? fmt::format("signal {}", soup.signal)
+                                              : fmt::format("exit code {}", soup.exit_code)));
+  {
+    std::size_t at = 0;
+    auto take = [&](void* p, std::size_t n) {
+      if (at + n > soup.output.size()) fail(path, "CGAL's reader process sent a short answer");
+      std::memcpy(p, soup.output.data() + at, n);
+      at += n;
+    };
+    std::uint64_t flags[3];
+    take(flags, sizeof flags);
+    read = flags[0] == 1;
+    points.reserve(flags[1]);
+    for (std::uint64_t i = 0; i < flags[1]; ++i) {
+      double x[3];
+      take(x, sizeof x);
+      points.emplace_back(x[0], x[1], x[2]);
+    }
+    polygons.reserve(flags[2]);
+    for (std::uint64_t i = 0; i < flags[2]; ++i) {
+      std::uint64_t n = 0;
+      take(&n, sizeof n);
+      if (n > soup.output.size()) fail(path, "CGAL's reader process sent a bad answer");
+      Polygon q(n);
+      take(q.data(), n * sizeof(std::size_t));
+      polygons.push_back(std::move(q));
+    }
+    const std::string error = soup.output.substr(at);
+    if (!error.empty()) fail(path, fmt::format("CGAL's {} reader failed: {}", ext.substr(1), error));
   }
   if (!read)
     fail(path, fmt::format("CGAL's {} reader could not read it (malformed or truncated: {} vertices and {} faces "
@@ -268,9 +424,26 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
     return c;
   };
   for (auto f : faces(mesh)) before.push_back(corners(f));
-  PMP::orient_to_bound_a_volume(mesh);
-  std::size_t flipped = 0;
-  for (auto f : faces(mesh)) flipped += corners(f) != before[f.idx()];
+  // CGAL 5.5's orient_to_bound_a_volume reads freed memory on some nearly degenerate surfaces
+  // (an OBJ cube with two corners 1e-16 apart, found by cairn_fuzz_geometry): it runs on a child
+  // process's copy of the mesh, which sends back which faces it turned, and a crash there is an
+  // input error; the turns are made here.
+  const ChildResult oriented = run_in_child(
+      [&](std::string& answer) {
+        PMP::orient_to_bound_a_volume(mesh);
+        for (auto f : faces(mesh)) answer.push_back(corners(f) != before[f.idx()] ? '1' : '0');
+        return 0;
+      },
+      300);
+  if (oriented.signal != 0 || oriented.timed_out || oriented.exit_code != 0 ||
+      oriented.output.size() != mesh.number_of_faces())
+    fail(path, "CGAL failed to orient the surface to bound a volume (a nearly degenerate surface: corners or faces "
+               "almost on each other?)");
+  std::vector<Mesh::Face_index> to_turn;
+  for (auto f : faces(mesh))
+    if (oriented.output[f.idx()] == '1') to_turn.push_back(f);
+  PMP::reverse_face_orientations(to_turn, mesh);
+  const std::size_t flipped = to_turn.size();
   if (turned > 0)
     out.warnings_.push_back(fmt::format("surface mesh '{}': {} edges joined faces of opposite orientation; {} faces "
                                         "turned to agree with their neighbours",

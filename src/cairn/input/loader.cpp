@@ -196,7 +196,7 @@ bool Loader::remove_undeclared(toml::table& root, std::vector<InputError>& error
   // Takes every key that `decls` do not declare out of `table` (at `path`, named `what`).
   auto scan = [&](toml::table& table, const Path& path, const std::vector<KeyDecl>& decls, const std::string& what) {
     for (const auto& [key, node] : entries_in_file_order(table))
-      if (std::none_of(decls.begin(), decls.end(), [&](const KeyDecl& d) { return d.name == key; })) {
+      if (std::none_of(decls.begin(), decls.end(), [&key = key](const KeyDecl& d) { return d.name == key; })) {
         errors.push_back(error(child(path, key), node, undeclared_key_expected(path, key, decls, what),
                                "an undeclared key"));
         table.erase(key);

@@ -20,7 +20,7 @@ void TableReader::fail(const std::string& name, const toml::node* node, const st
 void TableReader::reject_unknown_keys() const {
   if (!table_) return;
   for (const auto& [key, node] : entries_in_file_order(*table_))
-    if (std::none_of(decls_.begin(), decls_.end(), [&](const KeyDecl& d) { return d.name == key; }))
+    if (std::none_of(decls_.begin(), decls_.end(), [&key = key](const KeyDecl& d) { return d.name == key; }))
       loader_.fail(path_of(key), node, undeclared_key_expected(path_, key, decls_, what_), "an undeclared key");
 }
 

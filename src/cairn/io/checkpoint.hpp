@@ -38,6 +38,7 @@ namespace cairn {
 template <int D>
 struct CheckpointData {
   std::string engine = "mpm";  ///< the engine that wrote it (run/engine.hpp)
+  bool engine_named = true;     ///< false: a file written before engines had names (engine read as mpm)
   std::string config_toml;  ///< the resolved input, as TOML text
   double time = 0;
   long long step = 0;
@@ -69,11 +70,22 @@ void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>
 template <int D>
 void write_checkpoint(const std::filesystem::path& path, const CheckpointData<D>& data,
                       const Particles<D>& particles, const Comm& comm);
-/// Read a checkpoint written by write_checkpoint<D>. Throws std::runtime_error with a clear
-/// message if the file is missing, not HDF5, not a Cairn checkpoint, of another format version,
-/// of another dimension, or damaged.
+/// Read a checkpoint written by write_checkpoint<D>. Throws InputError (exit 2) naming the file
+/// and the attribute or dataset when the file is missing, not HDF5, not a Cairn checkpoint, of
+/// another format version or dimension, damaged (its checksum), or holds what this format does
+/// not: a missing dataset, one of another shape or type, a particle dataset of another length
+/// than /particles/mass, shapes larger than the file (docs/robustness.md, "Files from outside").
+/// The values are read as they are; check_checkpoint_values() says whether a run wrote them.
 template <int D>
 CheckpointData<D> read_checkpoint(const std::filesystem::path& path);
+
+/// Whether `data` (rows from `first_row` of the file `path`) holds values a run could have
+/// written: finite, masses, volumes and sizes not below zero, deformation gradients with a
+/// positive determinant, indices not negative, time, step and indices in range; InputError naming
+/// the object otherwise. The restart calls it (run/mpm_engine.cpp); read_checkpoint does not, so
+/// that any data round-trips.
+template <int D>
+void check_checkpoint_values(const std::filesystem::path& path, const CheckpointData<D>& data, std::size_t first_row);
 
 /// The same on each rank of `comm`: everything but the particles, and an equal share of the
 /// particle rows (any share: the run redistributes them; the file may come from any number of
@@ -82,10 +94,23 @@ template <int D>
 CheckpointData<D> read_checkpoint(const std::filesystem::path& path, const Comm& comm);
 /// The simulation dimension stored in a checkpoint (checks format and version the same way).
 int checkpoint_dimension(const std::filesystem::path& path);
+/// Read every object of the file `path` (its content checksum) in a child process: InputError
+/// when the HDF5 library crashes or hangs on it (HDF5 1.10 crashes on some damaged files, e.g. a
+/// corrupt global heap under a string attribute). checkpoint_engine() calls it first, so that
+/// restore_engine() reads no file that would end the run.
+void check_readable_by_hdf5(const std::filesystem::path& path);
 /// The engine that wrote a Cairn checkpoint of any engine (its `engine` attribute; files written
-/// before engines had names: "fem" for the FEM's format, else "mpm"). Throws std::runtime_error,
-/// as read_checkpoint does, for a file that is missing or no Cairn checkpoint.
+/// before engines had names: "fem" for the FEM's format, else "mpm"). Throws InputError, as
+/// read_checkpoint does, for a file that is missing or not HDF5.
 std::string checkpoint_engine(const std::filesystem::path& path);
+
+/// The run-loop scalar `name` stored in the checkpoint `path` (its /scalars); InputError naming
+/// the file and /scalars/names when it is missing. stored_count: the same for a count (a whole
+/// number 0..9e15; also an InputError otherwise).
+double stored_scalar(const std::map<std::string, double>& scalars, const std::string& name,
+                     const std::filesystem::path& path);
+long long stored_count(const std::map<std::string, double>& scalars, const std::string& name,
+                       const std::filesystem::path& path);
 
 extern template void write_checkpoint<1>(const std::filesystem::path&, const CheckpointData<1>&);
 extern template void write_checkpoint<2>(const std::filesystem::path&, const CheckpointData<2>&);

@@ -241,7 +241,15 @@ std::unique_ptr<Engine> restore_engine(const std::filesystem::path& checkpoint,
     for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
     all.push_back("output.directory=" + quoted + "\"");
   }
-  return EngineRegistry::instance().at(checkpoint_engine(checkpoint)).restore(checkpoint, all, options);
+  const std::string engine = checkpoint_engine(checkpoint);
+  const auto names = EngineRegistry::instance().names();
+  if (std::find(names.begin(), names.end(), engine) == names.end()) {
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(checkpoint.string(), 0, "engine", "the engine that wrote it, one of " + list,
+                     "'" + engine + "' (a damaged or edited checkpoint, or one of another build of Cairn)");
+  }
+  return EngineRegistry::instance().at(engine).restore(checkpoint, all, options);
 }
 
 RunSummary drive(Engine& engine, const RunOptions& options) {

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 
+#include "cairn/config/errors.hpp"
 #include "cairn/fem/output.hpp"
 #include "cairn/fem/solver.hpp"
 #include "cairn/io/history.hpp"
@@ -43,12 +44,22 @@ class FemEngine final : public Engine {
   }
 
   void restore(const Checkpoint& c) {
-    solver_.restore(c.state);
+    try {
+      solver_.restore(c.state);
+    } catch (const std::invalid_argument& e) {  // arrays of another mesh
+      throw InputError(config_.source_file, 0, "/x", "the nodes and elements of the mesh its stored input makes",
+                       std::string(e.what()) + " (a damaged or edited checkpoint)");
+    }
     initial_energy_ = c.scalars.at("initial_energy");
     schedule_.restore(c.scalars, c.scalars.at("time"));
     checkpoint_index_ = static_cast<int>(c.scalars.at("checkpoint_index"));
     last_dt_ = c.scalars.at("previous_dt");
-    history_writer_.set_rows(c.history_rows);
+    try {
+      history_writer_.set_rows(c.history_rows);
+    } catch (const std::invalid_argument& e) {  // rows of other columns than the stored input's run writes
+      throw InputError(config_.source_file, 0, "/history_rows", "rows of the history columns the stored input's run writes",
+                       std::string(e.what()) + " (a damaged or edited checkpoint)");
+    }
     snapshots_.set_entries(c.snapshots);
     restarted_ = true;
   }
@@ -188,7 +199,10 @@ std::unique_ptr<Engine> restore(const std::filesystem::path& checkpoint, const s
     throw std::invalid_argument(checkpoint.string() + ": [fem] runs on one MPI rank only (docs/parallel.md)");
   const Checkpoint data = read_checkpoint(checkpoint);
   const Config config = load_config_string(data.config_toml, checkpoint.string(), overrides);
-  if (!config.fem.enabled) throw std::invalid_argument("--set cannot turn an FEM checkpoint into an MPM run");
+  if (!config.fem.enabled)
+    throw InputError(checkpoint.string(), 0, "engine", "an input of the fem engine ([fem]), as an FEM checkpoint holds",
+                     fmt::format("an input of the '{}' engine (a damaged or edited checkpoint)",
+                                 EngineRegistry::instance().name_for(config)));
   auto engine = std::make_unique<FemEngine>(config);
   engine->restore(data);
   return engine;

@@ -149,10 +149,58 @@ class MpmEngine final : public Engine {
   MpmEngine& operator=(const MpmEngine&) = delete;
 
   void restore(const CheckpointData<D>& data) {
+    const std::string& file = config_.source_file;  // the checkpoint (restore_dim)
+    const Particles<D>& ps = data.particles;
+    const Particles<D>& setup = sim_.particles();  // what the stored input makes
+    auto refuse = [&](const std::string& object, const std::string& expected, const std::string& found) {
+      throw InputError(file, 0, object, expected, found + " (a damaged or edited checkpoint, or one of another input)");
+    };
+    // The particle layout the stored input's materials, update and conduction use (an APIC run
+    // may continue from a checkpoint without affine velocities: the step starts them at zero).
+    if (ps.n_state_per_particle != setup.n_state_per_particle)
+      refuse("/particles (attribute n_state_per_particle)",
+             fmt::format("{} state variables per particle, as the stored input's materials keep", setup.n_state_per_particle),
+             fmt::format("{}", ps.n_state_per_particle));
+    if (ps.has_temperature != setup.has_temperature)
+      refuse("/particles/temperature", setup.has_temperature ? "temperatures (the stored input conducts heat)" : "none (the stored input conducts no heat)",
+             ps.has_temperature ? "a dataset" : "none");
+    if (ps.has_affine && !setup.has_affine)
+      refuse("/particles/affine_velocity", "none (the stored input's update is not APIC)", "a dataset");
+    // The run-loop scalars this engine restores, before any of them is taken.
+    for (const char* name : {"external_work", "dissipated_energy", "next_full_mass_time", "initial_energy"})
+      (void)stored_scalar(data.scalars, name, file);
+    for (std::size_t w = 0; w < sim_.velocity_conditions().walls().size(); ++w)
+      (void)stored_scalar(data.scalars, fmt::format("wall_position_{}", w), file);
+    if (!exact_.empty()) (void)stored_scalar(data.scalars, "displacement_error_max", file);
+    for (const char* name : {"snapshots_done", "history_done", "checkpoints_done"}) (void)stored_count(data.scalars, name, file);
+    if (stored_count(data.scalars, "checkpoint_index", file) > 1000000000)
+      refuse("/scalars/values (checkpoint_index)", "a checkpoint index 0..1e9", "a larger one");
+    // Particle sizes: the stored input makes particles no larger than its largest (a larger
+    // stored one would widen a GIMP or CPDI stencil past its limit in the first step).
+    double largest[D] = {};
+    for (std::size_t p = 0; p < setup.n(); ++p)
+      for (int a = 0; a < D; ++a) largest[a] = std::max(largest[a], setup.size0[p][a]);
+    comm_.max(largest, D);
     // Each rank checks its share of the rows; a bad row stops every rank with the same message.
     std::string problem;
     try {
       check_positions_in_grid<D>(sim_.grid(), data.particles, config_.source_file);
+      for (std::size_t p = 0; p < ps.n(); ++p)
+        for (int a = 0; a < D; ++a)
+          if (ps.size0[p][a] > largest[a] * (1.0 + 1e-9))
+            refuse(fmt::format("/particles/size0[{}]", p),
+                   fmt::format("a particle size up to {:.6g}, the largest the stored input makes", largest[a]),
+                   fmt::format("{:.6g}", ps.size0[p][a]));
+      for (std::size_t p = 0; p < ps.n(); ++p) {
+        if (static_cast<std::size_t>(ps.material[p]) >= config_.materials.size())
+          refuse(fmt::format("/particles/material[{}]", p),
+                 fmt::format("a material index below {}, the stored input's materials", config_.materials.size()),
+                 fmt::format("{}", ps.material[p]));
+        if (static_cast<std::size_t>(ps.body[p]) >= config_.bodies.size())
+          refuse(fmt::format("/particles/body[{}]", p),
+                 fmt::format("a body index below {}, the stored input's bodies", config_.bodies.size()),
+                 fmt::format("{}", ps.body[p]));
+      }
     } catch (const InputError& e) {
       if (!comm_.parallel()) throw;
       problem = e.what();
@@ -178,7 +226,11 @@ class MpmEngine final : public Engine {
     schedule_.restore(data.scalars, data.time);
     checkpoint_index_ = static_cast<int>(data.scalars.at("checkpoint_index"));
     last_dt_ = data.previous_dt;
-    history_writer_.set_rows(rows_for_columns(data));
+    try {
+      history_writer_.set_rows(rows_for_columns(data));
+    } catch (const std::invalid_argument& e) {  // rows of other columns than the stored input's run writes
+      refuse("/history/rows", "rows of the history columns the stored input's run writes", e.what());
+    }
     // Every output ends where the checkpoint stands, before the first new step.
     flush_history();
     snapshots_.restore(data.snapshot_entries, data.snapshot_next_index);
@@ -560,9 +612,34 @@ std::unique_ptr<Engine> create(const Config& config, const std::string& name) {
 template <int D>
 std::unique_ptr<Engine> restore_dim(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   const CheckpointData<D> data = read_checkpoint<D>(file, Comm::world());
+  // Values no run writes stop every rank with the first bad rank's message (each rank read the
+  // rows after those of the ranks before it).
+  {
+    const Comm world = Comm::world();
+    const auto first_row = static_cast<std::size_t>(world.exclusive_prefix(static_cast<std::int64_t>(data.particles.n())));
+    std::string problem;
+    try {
+      check_checkpoint_values<D>(file, data, first_row);
+    } catch (const InputError& e) {
+      if (!world.parallel()) throw;
+      problem = e.what();
+    }
+    const std::int64_t first_bad =
+        world.min(problem.empty() ? std::int64_t{world.size()} : std::int64_t{world.rank()});
+    if (first_bad < world.size()) {
+      world.broadcast(problem, static_cast<int>(first_bad));
+      throw std::invalid_argument(problem);
+    }
+  }
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
+  // (--set cannot change the dimension or the engine: restore_engine refuses those keys.)
   if (config.simulation.dimension != D)
-    throw std::invalid_argument("--set cannot change simulation.dimension on restart");
+    throw InputError(file.string(), 0, "dimension",
+                     fmt::format("the dimension of the input stored in it, {}D", config.simulation.dimension),
+                     fmt::format("{}D in its root attribute 'dimension' (a damaged or edited checkpoint)", D));
+  if (const std::string selected = EngineRegistry::instance().name_for(config); data.engine_named && selected != data.engine)
+    throw InputError(file.string(), 0, "engine", fmt::format("'{}', the engine its stored input selects", selected),
+                     fmt::format("'{}' (a damaged or edited checkpoint)", data.engine));
   const double end = config.simulation.end_time;
   if (data.time >= end * (1.0 - 1e-12))
     throw InputError(file.string(), 0, "simulation.end_time",

@@ -1,0 +1,34 @@
+// Reading a file from outside in a child process: a third-party reader that crashes or hangs on a
+// damaged file (Gmsh 4.8 on an element with an undefined node, HDF5 1.10 on a corrupt global
+// heap) ends the child, not the run, and the caller reports an input error
+// (docs/robustness.md, "Files from outside").
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace cairn {
+
+/// How a child process ended.
+struct ChildResult {
+  bool timed_out = false;  ///< killed after the time limit
+  int signal = 0;          ///< the signal that ended it (0: it exited)
+  int exit_code = 0;       ///< its exit code when it exited
+  std::string output;      ///< what `work` put in its `out`
+};
+
+/// Run `work` in a forked child and wait for it at most `timeout_seconds`: the child's exit code
+/// is what `work` returns (an exception leaving it: 125), and `out` comes back as output. Only
+/// the calling thread runs in the child, with the default action for SIGSEGV, SIGBUS, SIGFPE,
+/// SIGILL and SIGABRT, and leaves by _exit (no atexit handlers, no leak check). A sanitizer may
+/// still catch a fault and exit with its own code: callers treat any exit code but the ones
+/// `work` returns as a crash. Throws std::runtime_error when no process can be started.
+ChildResult run_in_child(const std::function<int(std::string& out)>& work, int timeout_seconds);
+
+/// In a child: at most `bytes` more address space than the process has now (RLIMIT_AS), so that
+/// an allocation sized by a damaged count fails (std::bad_alloc) instead of taking the machine's
+/// memory. Under AddressSanitizer, whose own reservations are far larger, it does nothing (the
+/// sanitizer reports such allocations itself).
+void limit_address_space(double bytes);
+
+}  // namespace cairn
