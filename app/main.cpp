@@ -53,6 +53,11 @@ void print_summary(const cairn::RunSummary& s) {
                s.partitions, s.migrated, s.max_imbalance);
     fmt::print("cairn: halo of {} (parallel.halo), {:.0f} bytes sent per rank and step\n", s.halo,
                s.halo_bytes_per_step);
+    if (s.halo == "nodes")
+      fmt::print("cairn: node-halo sums took at most {:.3f} s on a rank ({:.1f}% of the run), {:.3f} s of it in "
+                 "the exchange (the most an overlap with the scatter could hide)\n",
+                 s.halo_seconds, s.wall_seconds > 0.0 ? 100.0 * s.halo_seconds / s.wall_seconds : 0.0,
+                 s.halo_wait_seconds);
   }
   for (const auto& note : s.body_notes) fmt::print("cairn: {}\n", note);
   fmt::print("cairn: output in {} (history.csv, {}, snapshots/)\n", s.output_directory.string(), s.xdmf);

@@ -81,7 +81,8 @@ Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers& 
   const std::size_t k = neighbours.size();
   Buffers recv(k);
   if (!parallel() || k == 0) return recv;
-  constexpr int tag_size = 7101, tag_data = 7102;
+  // A round of sizes, then the data as exchange_sized sends it.
+  constexpr int tag_size = 7101;
   std::vector<std::int64_t> send_size(k), recv_size(k);
   std::vector<MPI_Request> requests;
   requests.reserve(2 * k);
@@ -93,21 +94,8 @@ Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers& 
     MPI_Isend(&send_size[i], 1, MPI_INT64_T, neighbours[i], tag_size, MPI_COMM_WORLD, &requests.back());
   }
   MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
-  requests.clear();
-  for (std::size_t i = 0; i < k; ++i) {
-    recv[i].resize(static_cast<std::size_t>(recv_size[i]));
-    if (recv_size[i] > 0) {
-      requests.emplace_back();
-      MPI_Irecv(recv[i].data(), checked_count(recv[i].size()), MPI_BYTE, neighbours[i], tag_data, MPI_COMM_WORLD,
-                &requests.back());
-    }
-    if (!send[i].empty()) {
-      requests.emplace_back();
-      MPI_Isend(send[i].data(), checked_count(send[i].size()), MPI_BYTE, neighbours[i], tag_data, MPI_COMM_WORLD,
-                &requests.back());
-    }
-  }
-  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+  for (std::size_t i = 0; i < k; ++i) recv[i].resize(static_cast<std::size_t>(recv_size[i]));
+  exchange_sized(neighbours, send, recv);
   return recv;
 }
 

@@ -29,8 +29,10 @@ void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition,
   partitions_ = partitions;
   neighbours_.clear();
   shared_.clear();
-  slot_.clear();
   union_.clear();
+  holder_start_.assign(1, 0);
+  holders_.clear();
+  lower_.clear();
   const Grid<D> all = whole.whole();
   const Grid<D> mine = box_window(all, decomposition.box(rank_), margin);
   n_nodes_ = static_cast<std::size_t>(mine.n_nodes());
@@ -66,11 +68,22 @@ void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition,
       place[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(union_.size());
       union_.push_back(i);
     }
-  for (const auto& list : shared_) {
-    std::vector<std::int32_t> slots(list.size());
-    for (std::size_t s = 0; s < list.size(); ++s) slots[s] = place[static_cast<std::size_t>(list[s])];
-    slot_.push_back(std::move(slots));
+  // Per shared node, where each other holder's partial arrives, in increasing rank (CSR).
+  std::vector<std::vector<Holder>> of(union_.size());
+  for (std::size_t k = 0; k < shared_.size(); ++k)
+    for (std::size_t s = 0; s < shared_[k].size(); ++s)
+      of[static_cast<std::size_t>(place[static_cast<std::size_t>(shared_[k][s])])].push_back({k, s});
+  for (const auto& list : of) {
+    std::size_t lower = 0;
+    for (const Holder& h : list) {
+      lower += neighbours_[h.k] < rank_ ? 1 : 0;
+      holders_.push_back(h);
+    }
+    lower_.push_back(lower);
+    holder_start_.push_back(holders_.size());
   }
+  send_.assign(neighbours_.size(), {});
+  recv_.assign(neighbours_.size(), {});
 }
 
 template class NodeHalo<1>;

@@ -14,6 +14,7 @@
 // scheme by one exchange of the shared layers each way: the same bytes, one message latency.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -58,75 +59,73 @@ class NodeHalo {
 
   /// Sum every array (n_fields x n_nodes entries each, field-major, window storage) over the
   /// ranks sharing each node, in one exchange; afterwards every copy of a shared node holds
-  /// the same total.
+  /// the same total. The message buffers are kept between calls (no allocation in a step once
+  /// the largest sum has run).
   template <class... T>
-  void sum(int n_fields, std::vector<T>&... arrays) const {
+  void sum(int n_fields, std::vector<T>&... arrays) {
     if (neighbours_.empty()) return;
+    const auto started = std::chrono::steady_clock::now();
     // (Values travel as bytes: doubles and fixed-size Eigen vectors, plain data both.)
     const std::size_t row = (sizeof(T) + ... + 0) * static_cast<std::size_t>(n_fields);
-    const std::size_t k_max = neighbours_.size();
-    Comm::Buffers send(k_max), recv(k_max);
-    for (std::size_t k = 0; k < k_max; ++k) {
-      send[k].resize(shared_[k].size() * row);
-      recv[k].resize(shared_[k].size() * row);
-      char* out = send[k].data();
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      send_[k].resize(shared_[k].size() * row);
+      recv_[k].resize(shared_[k].size() * row);
+      char* out = send_[k].data();
       for (std::int32_t node : shared_[k])
         for (int f = 0; f < n_fields; ++f) {
           const std::size_t at = static_cast<std::size_t>(f) * n_nodes_ + static_cast<std::size_t>(node);
           ((std::memcpy(out, static_cast<const void*>(&arrays[at]), sizeof(T)), out += sizeof(T)), ...);
         }
+      bytes_sent_ += static_cast<std::int64_t>(send_[k].size());
     }
-    comm_.exchange_sized(neighbours_, send, recv);
-    bytes_sent_ += static_cast<std::int64_t>(send_bytes(send));
-    // The totals, in increasing rank over the holders of each node.
+    const auto packed = std::chrono::steady_clock::now();
+    comm_.exchange_sized(neighbours_, send_, recv_);
+    wait_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - packed).count();
     std::size_t offset = 0;
-    ((combine(arrays, n_fields, recv, row / static_cast<std::size_t>(n_fields), offset), offset += sizeof(T)), ...);
+    ((combine(arrays, n_fields, row / static_cast<std::size_t>(n_fields), offset), offset += sizeof(T)), ...);
+    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   }
 
-  /// Ranks this one shares nodes with, and how many nodes with each.
-  [[nodiscard]] const std::vector<int>& neighbours() const { return neighbours_; }
-  [[nodiscard]] std::size_t shared_nodes() const {
-    std::size_t n = 0;
-    for (const auto& s : shared_) n += s.size();
-    return n;
-  }
   /// Bytes this rank has sent in sums so far.
   [[nodiscard]] std::int64_t bytes_sent() const { return bytes_sent_; }
+  /// Seconds this rank has spent in sums so far (packing, exchange, totals).
+  [[nodiscard]] double seconds() const { return seconds_; }
+  /// Of those, the seconds in the exchange itself (waiting for the neighbours' messages): the
+  /// most that overlapping the exchange with other work could hide.
+  [[nodiscard]] double wait_seconds() const { return wait_seconds_; }
 
  private:
-  static std::size_t send_bytes(const Comm::Buffers& b) {
-    std::size_t n = 0;
-    for (const auto& x : b) n += x.size();
-    return n;
-  }
-  /// values[i] = sum over the holders of node i, in increasing rank, of their partials; the
-  /// partial of array T sits at byte `offset` of each field's part (`field_bytes` long) of a
-  /// node's row in the buffers.
+  /// values[i] = the sum over the holders of node i, in increasing rank, of their partials
+  /// (0 + p_r0 + p_r1 + ..., this rank's own in its place); the partial of array T sits at byte
+  /// `offset` of each field's part (`field_bytes` long) of a node's row in the buffers.
   template <class T>
-  void combine(std::vector<T>& values, int n_fields, const Comm::Buffers& recv, std::size_t field_bytes,
-               std::size_t offset) const {
+  void combine(std::vector<T>& values, int n_fields, std::size_t field_bytes, std::size_t offset) const {
     const std::size_t row = field_bytes * static_cast<std::size_t>(n_fields);
     T zero;
     if constexpr (std::is_arithmetic_v<T>) zero = T(0);
     else zero = T::Zero();
-    for (int f = 0; f < n_fields; ++f) {
-      const std::size_t base = static_cast<std::size_t>(f) * n_nodes_;
-      std::vector<T> total(union_.size(), zero);
-      auto add_from = [&](std::size_t k) {
-        const char* in = recv[k].data();
-        for (std::size_t s = 0; s < shared_[k].size(); ++s) {
-          T v;
-          std::memcpy(static_cast<void*>(&v), in + s * row + static_cast<std::size_t>(f) * field_bytes + offset, sizeof(T));
-          total[slot_[k][s]] += v;
-        }
-      };
-      std::size_t k = 0;
-      for (; k < neighbours_.size() && neighbours_[k] < rank_; ++k) add_from(k);
-      for (std::size_t u = 0; u < union_.size(); ++u) total[u] += values[base + static_cast<std::size_t>(union_[u])];
-      for (; k < neighbours_.size(); ++k) add_from(k);
-      for (std::size_t u = 0; u < union_.size(); ++u) values[base + static_cast<std::size_t>(union_[u])] = total[u];
+    auto partial = [&](const Holder& h, std::size_t f) {
+      T v;
+      std::memcpy(static_cast<void*>(&v), recv_[h.k].data() + h.s * row + f * field_bytes + offset, sizeof(T));
+      return v;
+    };
+    for (std::size_t f = 0; f < static_cast<std::size_t>(n_fields); ++f) {
+      T* field = values.data() + f * n_nodes_;
+      for (std::size_t u = 0; u < union_.size(); ++u) {
+        T total = zero;
+        const std::size_t first = holder_start_[u], mine = first + lower_[u], last = holder_start_[u + 1];
+        for (std::size_t h = first; h < mine; ++h) total += partial(holders_[h], f);
+        T& own = field[union_[u]];
+        total += own;
+        for (std::size_t h = mine; h < last; ++h) total += partial(holders_[h], f);
+        own = total;
+      }
     }
   }
+  /// Where a neighbour's partial of a shared node arrives: neighbour k, row s of its message.
+  struct Holder {
+    std::size_t k, s;
+  };
   Comm comm_ = Comm::serial();
   int rank_ = 0;
   int margin_ = -1;
@@ -134,9 +133,13 @@ class NodeHalo {
   std::size_t n_nodes_ = 0;
   std::vector<int> neighbours_;                     ///< increasing rank
   std::vector<std::vector<std::int32_t>> shared_;   ///< per neighbour: window nodes, canonical order
-  std::vector<std::vector<std::int32_t>> slot_;     ///< per neighbour: their place in union_
   std::vector<std::int32_t> union_;                 ///< every shared node of this window, once
-  mutable std::int64_t bytes_sent_ = 0;
+  std::vector<std::size_t> holder_start_;           ///< per union_ node: its holders_ (CSR)
+  std::vector<Holder> holders_;                     ///< the other holders of each, increasing rank
+  std::vector<std::size_t> lower_;                  ///< per union_ node: holders below this rank
+  Comm::Buffers send_, recv_;                       ///< per neighbour, kept between sums
+  std::int64_t bytes_sent_ = 0;
+  double seconds_ = 0.0, wait_seconds_ = 0.0;
 };
 
 }  // namespace cairn

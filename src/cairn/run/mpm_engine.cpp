@@ -277,6 +277,7 @@ class MpmEngine final : public Engine {
     start_ = last_autosave_ = Clock::now();
     first_step_ = sim_.step_count();
     halo_bytes_start_ = sim_.halo_bytes();
+    halo_seconds_start_ = {sim_.halo_seconds(), sim_.halo_wait_seconds()};
     if (!restarted_) {
       clear_earlier_outputs();
       if (const std::string note = time_step_note(config_); !note.empty() && comm_.is_root())
@@ -341,6 +342,8 @@ class MpmEngine final : public Engine {
       std::int64_t bytes = comm_.sum(sim_.halo_bytes() - halo_bytes_start_);
       summary.halo_bytes_per_step =
           summary.steps > 0 ? static_cast<double>(bytes) / comm_.size() / static_cast<double>(summary.steps) : 0.0;
+      summary.halo_seconds = comm_.max(sim_.halo_seconds() - halo_seconds_start_[0]);
+      summary.halo_wait_seconds = comm_.max(sim_.halo_wait_seconds() - halo_seconds_start_[1]);
     }
     summary.migrated = comm_.sum(sim_.distribution().received());
     summary.max_imbalance = max_imbalance_;
@@ -566,6 +569,7 @@ class MpmEngine final : public Engine {
   Clock::time_point start_{}, last_autosave_{};
   long long first_step_ = 0;
   std::int64_t halo_bytes_start_ = 0;  ///< halo bytes sent before this run's first step
+  std::array<double, 2> halo_seconds_start_{};  ///< seconds in node-halo sums and exchanges before it
   bool started_ = false;
   std::unique_ptr<ThreadTuner> tuner_;
 };

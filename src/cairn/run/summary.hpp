@@ -25,6 +25,8 @@ struct RunSummary {
   std::string xdmf = "particles.xdmf";    ///< the snapshot index in output_directory
   int ranks = 1;                ///< MPI ranks the run was distributed over
   std::string halo;             ///< several ranks: parallel.halo in effect (nodes | particles)
+  double halo_seconds = 0.0;         ///< node halo: the most seconds a rank spent in halo sums
+  double halo_wait_seconds = 0.0;    ///< of them, the most a rank spent in their exchanges
   double halo_bytes_per_step = 0.0;  ///< several ranks: mean bytes a rank sent per step in halo exchanges
   int partitions = 0;           ///< domain partitions (start-up and repartitions), several ranks
   long long migrated = 0;       ///< particles that moved between ranks

@@ -113,6 +113,10 @@ class Simulation {
   [[nodiscard]] std::int64_t halo_bytes() const {
     return node_halo_ ? halo_.bytes_sent() : distribution_.ghost_bytes_sent();
   }
+  /// Seconds this rank has spent in node-halo sums, and in their exchanges (0 for the particle
+  /// halo).
+  [[nodiscard]] double halo_seconds() const { return node_halo_ ? halo_.seconds() : 0.0; }
+  [[nodiscard]] double halo_wait_seconds() const { return node_halo_ ? halo_.wait_seconds() : 0.0; }
   /// Largest particle count of a rank over the mean count at the start of the last step (1 on
   /// one rank).
   [[nodiscard]] double imbalance() const { return imbalance_; }
