@@ -12,7 +12,9 @@ Checks (docs/parallel.md, "Determinism"):
   - --migrate / --repartition: the MPI run moved particles between ranks / partitioned the
     domain again (its summary line says how often);
   - --restart N:M: the checkpoint the N-rank run wrote first, continued on M ranks, ends with
-    the serial run's history and final particles.
+    the serial run's history and final particles;
+  - --compression Z: every run writes gzip level Z (output.compression), and the MPI runs' last
+    snapshot and first checkpoint hold compressed datasets (written collectively).
 Exit 0 only when every check holds; the last line says RESULT: ...
 """
 import argparse
@@ -156,6 +158,22 @@ def counts(summary):
     return int(m.group(1)), int(m.group(2))
 
 
+def check_compressed(run_dir, label):
+    """The largest particle dataset of the last snapshot and of the first checkpoint is gzip'd."""
+    problems = []
+    files = [sorted((run_dir / "snapshots").glob("particles-*.h5"))[-1]]
+    if (run_dir / "checkpoint-0000.h5").exists():
+        files.append(run_dir / "checkpoint-0000.h5")
+    for path in files:
+        with h5py.File(path, "r") as f:
+            sets = [d for d in f["particles"].values() if isinstance(d, h5py.Dataset)]
+            largest = max(sets, key=lambda d: d.size)
+            if largest.compression != "gzip":
+                problems.append(f"{label}: {path.name} {largest.name} is not compressed ({largest.compression})")
+    print(f"{label}: {len(files)} files with compressed datasets checked")
+    return problems
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--cairn", required=True)
@@ -170,13 +188,15 @@ def main():
                     help="parallel.halo of the MPI runs (nodes: compared to round-off, see --tolerance)")
     ap.add_argument("--tolerance", type=float, default=1e-12,
                     help="--halo nodes: largest difference over the largest magnitude of a column/dataset")
+    ap.add_argument("--compression", type=int, default=0, help="output.compression of every run (0: plain)")
     args = ap.parse_args()
-    halo = ["--set", f'parallel.halo="{args.halo}"']
+    common = ["--set", f"output.compression={args.compression}"] if args.compression else []  # every run
+    halo = ["--set", f'parallel.halo="{args.halo}"'] + common
     tol = args.tolerance if args.halo != "particles" else 0.0
     args.out.mkdir(parents=True, exist_ok=True)
     problems = []
     serial = args.out / "serial"
-    run([args.cairn, "run", args.case, "--set", f"output.directory=\"{serial}\""])
+    run([args.cairn, "run", args.case, "--set", f"output.directory=\"{serial}\""] + common)
     for n in args.np:
         d = args.out / f"np{n}"
         summary = run(mpirun(args, n) + [args.cairn, "run", args.case, "--set", f"output.directory=\"{d}\""] + halo)
@@ -192,6 +212,8 @@ def main():
             problems.append(f"np {n}: the domain was never repartitioned")
         problems += compare_history(serial, d, f"np {n}", tolerance=tol)
         problems += compare_snapshots(serial, d, f"np {n}", tolerance=tol)
+        if args.compression:
+            problems += check_compressed(d, f"np {n}")
         if tol > 0 and n == args.np[0]:
             # The same ranks again: the node sums' fixed order gives the same bits.
             again = args.out / f"np{n}-again"

@@ -286,7 +286,7 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
     }
     {
       const Particles<D>& ps = particles;
-      const int z = comm.parallel() ? 0 : data.metadata.compression;
+      const int z = data.metadata.compression;
       h5::Handle g = h5::create_group(root, "particles");
       const hid_t gid = g.get();
       h5::write_int64_attribute(gid, "n_state_per_particle", ps.n_state_per_particle);

@@ -87,7 +87,6 @@ Handle creation_properties(const std::vector<hsize_t>& dims, std::size_t element
 void write_dataset(hid_t loc, const std::string& name, hid_t ftype, hid_t mtype,
                    const std::vector<hsize_t>& dims, const void* data, int deflate = 0) {
   const Access a = access_of(loc);
-  if (a.parallel) deflate = 0;  // parallel files: no filters (docs/parallel.md)
   Handle space = simple_space(dims, loc, name);
   Handle dcpl = creation_properties(dims, H5Tget_size(ftype), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
@@ -118,8 +117,11 @@ void write_dataset_rows(hid_t loc, const std::string& name, hid_t ftype, hid_t m
     return;
   }
   Handle space = simple_space(dims, loc, name);
+  // Filtered (compressed) datasets are written collectively, each rank its rows: parallel HDF5
+  // >= 1.10.2 compresses a chunk that several ranks' rows share on one of them.
+  Handle dcpl = creation_properties(dims, H5Tget_size(ftype), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), ftype, space.get(), H5P_DEFAULT,
-                                   H5P_DEFAULT, H5P_DEFAULT),
+                                   dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);
   if (rows.total == 0) return;
   const double dummy = 0.0;
@@ -326,7 +328,7 @@ void write_doubles_blocked(hid_t loc, const std::string& name, Rows rows, std::s
   const Access a = access_of(loc);
   const std::vector<hsize_t> dims{rows.total, cols};
   Handle space = simple_space(dims, loc, name);
-  Handle dcpl = creation_properties(dims, sizeof(double), a.parallel ? 0 : deflate, loc, name);
+  Handle dcpl = creation_properties(dims, sizeof(double), deflate, loc, name);
   Handle dset = checked(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
                                    dcpl.get(), H5P_DEFAULT),
                         H5Dclose, "cannot create dataset", loc, name);

@@ -108,7 +108,8 @@ void write_doubles_box(hid_t loc, const std::string& name, const double* data, c
 
 // `deflate` (0-9, output.compression): datasets of at least `min_compressed_elements` values are
 // stored chunked (about 1 MiB per chunk, whole rows) with the shuffle and gzip filters at that
-// level; 0 stores every dataset contiguous and uncompressed.
+// level; 0 stores every dataset contiguous and uncompressed. In a file written by several ranks
+// the writes are collective, which parallel HDF5 (>= 1.10.2) needs for filtered datasets.
 inline constexpr std::size_t min_compressed_elements = 4096;
 
 /// Write a double dataset: 1D of length `rows` if `cols` == 0, else rows x cols (row-major).

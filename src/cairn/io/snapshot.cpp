@@ -225,8 +225,7 @@ void SnapshotWriter<D>::write(const Particles<D>& particles, double time, long l
   }
 
   const fs::path target = snapshot_path(next_index_);
-  // Parallel HDF5 here writes no filtered (compressed) datasets: several ranks write plain ones.
-  const int z = comm_.parallel() ? 0 : meta_.compression;
+  const int z = meta_.compression;  // several ranks: written collectively (h5::write_doubles_rows)
   const std::string length = meta_.unit(Quantity::length), vel = meta_.unit(Quantity::velocity);
   const std::string stress_unit = meta_.unit(Quantity::stress), mass_unit = meta_.unit(Quantity::mass);
   write_file_atomically(target, comm_, [&](const fs::path& tmp) {
