@@ -76,6 +76,10 @@ void corner_shape(int corner, const Vec<D>& xi, const Vec<D>& inv_h, double& S, 
 template <int D>
 Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
     : options_(options), h_(grid.cell_size()), n_cells_(grid.n_cells()) {
+  for (int a = 0; a < D; ++a) {
+    periodic_[a] = grid.periodic(a);
+    any_periodic_ |= periodic_[a];
+  }
   const std::int32_t n = grid.n_nodes();
   moment_.assign(n, {});
   load_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
@@ -119,7 +123,10 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
       bool outside = false;
       for (int a = 0; a < D; ++a) {
         cell[a] = static_cast<int>(std::floor(xi[a]));
-        outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
+        // A periodic axis does not wrap the positions (sim/resources.cpp): every cell index is
+        // inside, and axis_index wraps the nodes; r below is then measured to the node's image
+        // next to the particle.
+        if (!periodic_[a]) outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
         const int nearest = static_cast<int>(std::floor(xi[a] + 0.5));
         const double local = xi[a] - cell[a];
         for (int k = 0; k < 3; ++k) {
@@ -180,7 +187,8 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
 template <int D>
 void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
                             const std::vector<double>& density0, const std::vector<Vec<D>>* body_acceleration,
-                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force) {
+                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force,
+                            const std::vector<Vec<D>>* surface_force) {
   const auto n = static_cast<std::int64_t>(particles.n());
   const bool body_force = body_acceleration != nullptr;
   const int n_used = body_force ? n_fields : n_fields - D;
@@ -217,7 +225,15 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
       const bool surface = is_surface(particles, static_cast<std::size_t>(p));
       beta_[i] += S * (surface ? 1.0 : 2.0);
       if (surface) {
-        surface_sum_[i] += S * particles.position[p];
+        // Along a periodic axis the particle's image next to the node (x_i + r h), so that
+        // x_surf of a node on the seam averages the particles on both sides of it.
+        Vec<D> x = particles.position[p];
+        if (any_periodic_) {
+          const Vec<D> xi = grid.node_position(i);
+          for (int a = 0; a < D; ++a)
+            if (periodic_[a]) x[a] = xi[a] + offset_[s][a] * h_[a];
+        }
+        surface_sum_[i] += S * x;
         surface_weight_[i] += S;
       }
     }
@@ -247,7 +263,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
-  integrate(grid, body_force, nodes, node_body_force);
+  integrate(grid, body_force, nodes, node_body_force, surface_force);
 }
 
 template <int D>
@@ -509,6 +525,7 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
     bool inside = true;
     for (int a = 0; a < D; ++a) {
       cell[a] -= (k >> a) & 1;
+      if (periodic_[a] && cell[a] < 0) cell[a] += n_cells_[a];  // node 0's lower cell: the last one
       inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
     }
     if (!inside) continue;
@@ -526,7 +543,7 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
 
 template <int D>
 void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
-                              std::vector<Vec<D>>* node_body_force) {
+                              std::vector<Vec<D>>* node_body_force, const std::vector<Vec<D>>* surface_force) {
   const std::int32_t n_nodes = grid.n_nodes();
   // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
   for_each_node(n_nodes, [&](std::int32_t i) {
@@ -539,13 +556,20 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     });
     nodes.mass[i] = m;
     nodes.momentum[i] = m * velocity_[i];
+    // A traction's node force (seed 000 Sec. 2.4 with S of Eq. 5) is the surface term of the
+    // weak form whose volume term is Eq. 24: at a surface node in equilibrium the two cancel.
+    // It stays with Eq. 24 below, so that a spurious node (a sliver of a cut cell, whose mass
+    // shrinks faster than its share of the face) takes its neighbours' mean of both instead of
+    // being accelerated by its share of the load alone (docs/wls.md).
+    if (surface_force) fi += (*surface_force)[i];
     internal_force_[i] = fi;
     nodes.force[i] = fe;
     if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
     if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
   });
-  // Sec. 3.5 / 4.5: the internal force of a spurious node is the mean over its 3^D - 1
-  // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
+  // Sec. 3.5 / 4.5: the internal force (with the surface loads) of a spurious node is the mean
+  // over its 3^D - 1 neighbours that are well conditioned and carry mass (per unit mass by
+  // default, docs/wls.md).
   for_each_node(n_nodes, [&](std::int32_t i) {
     Vec<D> fi = internal_force_[i];
     if (!alpha_[i] && nodes.mass[i] > 0.0 && !options_.integrated_spurious_force) {
