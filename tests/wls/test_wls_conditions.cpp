@@ -307,22 +307,43 @@ TEST(WlsConditions, PeriodicAxisNeedsThreeCells) {
 }  // namespace
 }  // namespace cairn
 namespace cairn {
-TEST(WlsDebug, Wall) {
-  Config c = bar_config(2, 0.425, true);
-  WallConfig w;
-  w.name = "piston";
-  w.axis = 0;
-  w.position = 0.425;
-  w.depth = 0.0;
-  w.velocity = "t < 0.1 ? -0.5 * 4e-4 * pi / 0.1 * sin(pi * t / 0.1) : 0";
-  c.walls.push_back(w);
-  Simulation<2> sim(c);
-  while (sim.time() < 0.15) sim.step(sim.next_dt());
-  const auto& P = sim.particles();
-  for (std::size_t p = 0; p < P.n(); ++p)
-    if (std::abs(P.reference_position[p][1] - 0.3875) < 1e-3 && false || (wls::is_surface(P, p) && std::abs(P.reference_position[p][1] - 0.4125) < 0.02))
-      std::printf("X %.4f u %.4e (lin %.4e) sxx %.1f surf %d\n", P.reference_position[p][0], P.position[p][0] - P.reference_position[p][0],
-                  -4e-4 * P.reference_position[p][0] / 0.425, P.kirchhoff_stress[p](0, 0), (int)wls::is_surface(P, p));
-  for (const auto& e : sim.velocity_conditions().entries()) std::printf("entry node x %g y %g end %g\n", sim.grid().node_position(e.node)[0], sim.grid().node_position(e.node)[1], e.end);
+void run_variant(const char* name, bool wall, const std::string& pv, const std::string& vg, double depth, bool estimate, double cfl = 0.4, double L = 0.425) {
+  Config c = bar_config(2, L, true);
+  c.simulation.cfl = cfl;
+  if (cfl == 0.3) { c.bodies[0].shape.min[1] = 0.3; c.bodies[0].shape.max[1] = 0.5; }
+  c.method.plugin.set("point_values", pv);
+  c.method.plugin.set("velocity_gradient", vg);
+  if (wall) {
+    WallConfig w;
+    w.name = "piston";
+    w.axis = 0;
+    w.position = 0.425;
+    w.depth = depth;
+    if (estimate) w.gradient = WallGradient::estimate;
+    w.velocity = "t < 0.1 ? -0.5 * 4e-4 * pi / 0.1 * sin(pi * t / 0.1) : 0";
+    c.walls.push_back(w);
+  } else {
+    c.tractions.push_back(end_traction(2, 1.0e3, "t < 0.1 ? 0.5 * (1 - cos(pi * t / 0.1)) : 1"));
+  }
+  try {
+    Simulation<2> sim(c);
+    double sxx = 0, lo = 1e30, hi = -1e30; int n = 0;
+    while (sim.time() < 0.2 - 1e-12) {
+      sim.step(sim.next_dt());
+      if (sim.time() < 0.15) continue;
+      const auto [xx, yy] = mean_stress(sim, 0.3);
+      sxx += xx; ++n; lo = std::min(lo, xx); hi = std::max(hi, xx);
+    }
+    double spread = 0; const auto& P = sim.particles();
+    for (std::size_t p = 0; p < P.n(); ++p) if (!wls::is_surface(P, p) && P.reference_position[p][0] < 0.3) spread = std::max(spread, std::abs(P.kirchhoff_stress[p](0,0) - sxx / n));
+    std::printf("%s %s pv=%s vg=%s depth=%g est=%d: sxx mean %.1f range [%.1f, %.1f] particle spread %.1f\n", name, wall ? "wall" : "traction", pv.c_str(), vg.c_str(), depth, (int)estimate, sxx / n, lo, hi, spread);
+  } catch (const std::exception& e) {
+    std::printf("%s %s pv=%s vg=%s: FAILED %s\n", name, wall ? "wall" : "traction", pv.c_str(), vg.c_str(), e.what());
+  }
+}
+TEST(WlsDebug, Variants) {
+  run_variant("v", false, "node", "quadrature", 0, false, 0.3, 0.425);
+  run_variant("v", false, "node", "quadrature", 0, false, 0.3, 0.45);
+  run_variant("v", false, "fit", "narrow", 0, false, 0.4, 0.45);
 }
 }
