@@ -1,7 +1,7 @@
 // The engine's conditions under the WLS method (seed 001; issue 35 item 4, docs/wls.md "The
-// engine's conditions"): tractions on particle faces (seed 000 Sec. 2.4 with the narrow shape
-// S of seed 001 Eq. 5), moving walls (seed 000 Sec. 2.5) on the WLS grid update (Eq. 25-26), and
-// periodic axes (the stencils, fits, cut cells and node sums wrap across the seam).
+// engine's conditions"): moving walls (seed 000 Sec. 2.5) on the WLS grid update (Eq. 25-26),
+// periodic axes (the stencils, fits, cut cells and node sums wrap across the seam), and the
+// refusal of tractions.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -36,16 +36,6 @@ Config bar_config(int D, double L, bool held) {
   return c;
 }
 
-TractionConfig end_traction(int D, double T, const std::string& scale) {
-  TractionConfig t;
-  t.name = "pull";
-  t.side = 1;  // x_max
-  t.traction.assign(D, 0.0);
-  t.traction[0] = T;
-  t.scale = scale;
-  return t;
-}
-
 /// Mean Cauchy stress sigma_xx, sigma_yy of the particles with volume and x < x_max.
 template <int D>
 std::pair<double, double> mean_stress(const Simulation<D>& sim, double x_max) {
@@ -62,128 +52,27 @@ std::pair<double, double> mean_stress(const Simulation<D>& sim, double x_max) {
   return {sxx / n, syy / n};
 }
 
-// ---- tractions ----------------------------------------------------------------------------------
+// ---- tractions (refused) -----------------------------------------------------------------------
 
-template <int D>
-void check_traction_forces() {
-  // An unstressed free bar, one step: every node force is the traction's (no stress, no body
-  // force), the faces are those of the lattice particles on x = L (the surface particles there
-  // have none), and the node forces sum to T times the face area.
-  Config c = bar_config(D, 0.425, false);
-  const double T = 1.0e3;
-  c.tractions.push_back(end_traction(D, T, "1"));
-  Simulation<D> sim(c);
-  const std::size_t faces = D == 2 ? 10 : 100;  // 0.25 / 0.025 particles across, per transverse axis
-  EXPECT_EQ(sim.tractions().n_faces(0), faces);
-  sim.step(sim.next_dt());
-  const double area = D == 2 ? 0.25 * c.simulation.thickness : 0.0625;
-  EXPECT_NEAR(sim.tractions().total_force(0)[0], T * area, 1e-12 * T * area);
-  Vec<D> sum = Vec<D>::Zero();
-  const auto& nodes = sim.nodes();
-  for (std::int32_t i = 0; i < sim.grid().n_nodes(); ++i) {
-    sum += nodes.force[i];
-    // The face centres lie at x = 0.425: only the nodes of the node planes x = 0.4 and 0.45
-    // carry the load.
-    if (nodes.force[i].norm() > 1e-9 * T * area) {
-      const double x = sim.grid().node_position(i)[0];
-      EXPECT_TRUE(std::abs(x - 0.4) < 1e-12 || std::abs(x - 0.45) < 1e-12) << i;
-      EXPECT_GT(nodes.mass[i], 0.0) << i;
-    }
-  }
-  EXPECT_NEAR(sum[0], T * area, 1e-12 * T * area);
-  for (int a = 1; a < D; ++a) EXPECT_NEAR(sum[a], 0.0, 1e-12 * T * area);
-}
-
-TEST(WlsConditions, TractionNodeForcesSumToTheLoad) {
-  ASSERT_NO_FATAL_FAILURE(check_traction_forces<2>());
-  ASSERT_NO_FATAL_FAILURE(check_traction_forces<3>());
-}
-
-TEST(WlsConditions, TractionAcceleratesAFreeBody) {
-  // A free bar pulled at one end for a few wave transits: its momentum grows with the load's
-  // impulse T A t. Not exactly: WLS's node masses are the cut-cell integrals (seed 001 Eq. 22,
-  // the rounded corners lose h^2/2 each) and its particle update (Eq. 27) weighs the node
-  // accelerations with the particles' masses, so the particles' momentum follows the impulse
-  // only to about the difference of those masses (measured: below 1 %).
-  Config c = bar_config(2, 0.425, false);
-  const double T = 1.0e3;
-  c.tractions.push_back(end_traction(2, T, "1"));
-  c.simulation.end_time = 0.04;
-  Simulation<2> sim(c);
-  while (sim.time() < 0.04 - 1e-12) sim.step(sim.next_dt());
-  const auto& P = sim.particles();
-  double px = 0.0, py = 0.0, mass = 0.0;
-  for (std::size_t p = 0; p < P.n(); ++p) {
-    px += P.mass[p] * P.velocity[p][0];
-    py += P.mass[p] * P.velocity[p][1];
-    mass += P.mass[p];
-  }
-  // Central differences (seed 001 Sec. 4.7): the particles carry the velocity of t - dt/2, which
-  // brackets the impulse between its values at t - dt and t.
-  const double impulse = T * 0.25 * c.simulation.thickness * sim.time();
-  std::printf("free bar: momentum %.6g, impulse T A t %.6g (ratio %.5f), transverse %.3g\n", px, impulse,
-              px / impulse, py);
-  EXPECT_NEAR(px / impulse, 1.0, 0.02);
-  EXPECT_NEAR(py, 0.0, 1e-9 * impulse);
-  EXPECT_NEAR(mass, rho * 0.425 * 0.25 * c.simulation.thickness, 1e-9);
-}
-
-TEST(WlsConditions, HeldBarCarriesTheTraction) {
-  // A bar on a symmetry face, pulled at x = 0.425 by a traction ramped smoothly over eight wave
-  // transits (c = sqrt(E/rho), L/c = 0.0126) and then held: it carries sigma_xx = T, sigma_yy =
-  // 0, and its end moves by T L / E.
+TEST(WlsConditions, TractionsAreRefused) {
+  // docs/wls.md, "Tractions": a held bar under a sustained end traction grew node-scale noise
+  // or blew up, depending on where the loaded face sits in its cells.
   Config c = bar_config(2, 0.425, true);
-  const double T = 1.0e3, ramp = 0.1;
-  c.tractions.push_back(end_traction(2, T, "t < 0.1 ? 0.5 * (1 - cos(pi * t / 0.1)) : 1"));
-  c.simulation.end_time = 0.2;
-  Simulation<2> sim(c);
-  double sxx = 0.0, syy = 0.0, end = 0.0;
-  int samples = 0;
-  const auto& P = sim.particles();
-  while (sim.time() < 0.2 - 1e-12) {
-    sim.step(sim.next_dt());
-    if (sim.time() < ramp + 0.05) continue;
-    const auto [xx, yy] = mean_stress(sim, 0.3);
-    sxx += xx;
-    syy += yy;
-    double u = 0.0;
-    int n = 0;
-    for (std::size_t p = 0; p < P.n(); ++p)
-      if (!wls::is_surface(P, p) && P.reference_position[p][0] > 0.4) {
-        u += P.position[p][0] - P.reference_position[p][0];
-        ++n;
-      }
-    end += u / n;
-    ++samples;
-  }
-  sxx /= samples;
-  syy /= samples;
-  end /= samples;
-  // The particles next to x = 0.425 sit at X = 0.4125: their displacement is T X / E.
-  std::printf("held bar: sigma_xx %.5g (T = %g), sigma_yy %.3g, end displacement %.5g (T X / E = %.5g)\n", sxx, T,
-              syy, end, T * 0.4125 / E);
-  EXPECT_NEAR(sxx / T, 1.0, 0.02);
-  EXPECT_NEAR(syy / T, 0.0, 0.02);
-  EXPECT_NEAR(end / (T * 0.4125 / E), 1.0, 0.03);
-}
-
-TEST(WlsConditions, TractionOnARadialBodyIsRefused) {
-  Config c = bar_config(2, 0.425, false);
-  auto& b = c.bodies[0];
-  b.shape.kind = "circle";
-  b.shape.center = {0.5, 0.5};
-  b.shape.radius = 0.3;
-  b.arrangement = "radial";
-  c.tractions.push_back(end_traction(2, 1.0, "1"));
+  TractionConfig t;
+  t.name = "pull";
+  t.side = 1;
+  t.traction = {1.0e3, 0.0};
+  c.tractions.push_back(t);
   EXPECT_THROW(Simulation<2>{c}, std::invalid_argument);
 }
 
 // ---- moving walls -------------------------------------------------------------------------------
 
 TEST(WlsConditions, MovingWallCompressesAHeldBar) {
-  // The bar [0, 0.425] on a symmetry face, pushed at x = 0.425 by a wall that moves by -delta with a
-  // smooth velocity history over 0.1 and then stops: the wall's nodes move with the wall every
-  // step, and the bar ends uniformly compressed, sigma_xx = -E delta / L.
+  // The bar [0, 0.425] on a symmetry face, pushed at x = 0.425 by a wall that moves by -delta
+  // with a smooth velocity history over 0.1 (eight wave transits) and then stops: the wall's
+  // nodes move with the wall every step, and the bar ends uniformly compressed, sigma_xx =
+  // -E delta / L (measured 0.9 % below; the particles' stresses scatter by about 15 % of it).
   Config c = bar_config(2, 0.425, true);
   const double delta = 4.0e-4, t_r = 0.1;
   WallConfig w;
@@ -191,7 +80,8 @@ TEST(WlsConditions, MovingWallCompressesAHeldBar) {
   w.axis = 0;
   w.inside_below = true;
   w.position = 0.425;
-  w.depth = 0.0;  // the nodes on the wall and the ones beyond it with mass: the whole bar strains
+  // Default depth (1 cell) and gradient (zero): the wall holds the nodes within a cell inside
+  // the material and those beyond it that carry mass (seed 000 Sec. 2.5).
   w.velocity = "t < 0.1 ? -0.5 * 4e-4 * pi / 0.1 * sin(pi * t / 0.1) : 0";
   c.walls.push_back(w);
   c.simulation.end_time = 0.2;
@@ -306,44 +196,3 @@ TEST(WlsConditions, PeriodicAxisNeedsThreeCells) {
 
 }  // namespace
 }  // namespace cairn
-namespace cairn {
-void run_variant(const char* name, bool wall, const std::string& pv, const std::string& vg, double depth, bool estimate, double cfl = 0.4, double L = 0.425) {
-  Config c = bar_config(2, L, true);
-  c.simulation.cfl = cfl;
-  if (cfl == 0.3) { c.bodies[0].shape.min[1] = 0.3; c.bodies[0].shape.max[1] = 0.5; }
-  c.method.plugin.set("point_values", pv);
-  c.method.plugin.set("velocity_gradient", vg);
-  if (wall) {
-    WallConfig w;
-    w.name = "piston";
-    w.axis = 0;
-    w.position = 0.425;
-    w.depth = depth;
-    if (estimate) w.gradient = WallGradient::estimate;
-    w.velocity = "t < 0.1 ? -0.5 * 4e-4 * pi / 0.1 * sin(pi * t / 0.1) : 0";
-    c.walls.push_back(w);
-  } else {
-    c.tractions.push_back(end_traction(2, 1.0e3, "t < 0.1 ? 0.5 * (1 - cos(pi * t / 0.1)) : 1"));
-  }
-  try {
-    Simulation<2> sim(c);
-    double sxx = 0, lo = 1e30, hi = -1e30; int n = 0;
-    while (sim.time() < 0.2 - 1e-12) {
-      sim.step(sim.next_dt());
-      if (sim.time() < 0.15) continue;
-      const auto [xx, yy] = mean_stress(sim, 0.3);
-      sxx += xx; ++n; lo = std::min(lo, xx); hi = std::max(hi, xx);
-    }
-    double spread = 0; const auto& P = sim.particles();
-    for (std::size_t p = 0; p < P.n(); ++p) if (!wls::is_surface(P, p) && P.reference_position[p][0] < 0.3) spread = std::max(spread, std::abs(P.kirchhoff_stress[p](0,0) - sxx / n));
-    std::printf("%s %s pv=%s vg=%s depth=%g est=%d: sxx mean %.1f range [%.1f, %.1f] particle spread %.1f\n", name, wall ? "wall" : "traction", pv.c_str(), vg.c_str(), depth, (int)estimate, sxx / n, lo, hi, spread);
-  } catch (const std::exception& e) {
-    std::printf("%s %s pv=%s vg=%s: FAILED %s\n", name, wall ? "wall" : "traction", pv.c_str(), vg.c_str(), e.what());
-  }
-}
-TEST(WlsDebug, Variants) {
-  run_variant("v", false, "node", "quadrature", 0, false, 0.3, 0.425);
-  run_variant("v", false, "node", "quadrature", 0, false, 0.3, 0.45);
-  run_variant("v", false, "fit", "narrow", 0, false, 0.4, 0.45);
-}
-}

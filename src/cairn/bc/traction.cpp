@@ -35,11 +35,8 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
   domain_ = domain;
   // Occupied lattice sites per body.
   std::vector<std::unordered_set<std::int64_t>> occupied(config.bodies.size());
-  // (A zero-volume sample point, a WLS surface particle, occupies no site.)
   for (std::size_t p = 0; p < particles.n(); ++p)
-    if (particles.volume0[p] > 0.0)
-      occupied[particles.body[p]].insert(
-          lattice_site(particles.reference_position[p], grid.origin(), particles.size0[p]));
+    occupied[particles.body[p]].insert(lattice_site(particles.reference_position[p], grid.origin(), particles.size0[p]));
   select(config, grid, particles, occupied, Comm::serial());
 }
 
@@ -71,9 +68,6 @@ void Tractions<D>::select(const Config& config, const Grid<D>& grid, const Parti
     const bool has_box = !tc.box_min.empty();
     for (std::size_t p = 0; p < particles.n(); ++p) {
       if (body >= 0 && particles.body[p] != body) continue;
-      // A particle without volume has no faces: the surface particles of WLS (seed 001 Eq. 13,
-      // wls/arrangement.hpp), sample points on the surface between lattice sites.
-      if (!(particles.volume0[p] > 0.0)) continue;
       const Vec<D>& X = particles.reference_position[p];
       const Vec<D>& l0 = particles.size0[p];
       for (int a = 0; a < D; ++a)

@@ -176,27 +176,6 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   // Conditions and tractions select their nodes and faces on the whole grid and every particle
   // (the faces gathered from every rank), so that a selection holding none is refused the same
   // way on any number of ranks.
-  const bool wls = config_.method.integration == "wls";
-  ParticleDomain face_domain = shape_->particle_domain();
-  if (wls && !config_.tractions.empty()) {
-    // WLS: a face's nodal force is T A_s times the narrow shape S_i of seed 001 Eq. 5 at the
-    // face centre (the linear family's stencil of the face proxy, bc/traction.hpp); the face is
-    // convected by the particle's F, as the cut cells follow the deformed body. A face of a
-    // lattice particle with ppc particles per cell lies inside one cell, where S_i is linear
-    // (bilinear in 3D), so its centre value is the exact face average of S_i.
-    MethodConfig linear = config_.method;
-    linear.shape = "linear";
-    face_shape_ = make_shape_family<D>(ShapeContext{linear, D});  // (keeps nothing of the context)
-    face_domain = ParticleDomain::convected;
-    // Faces are those of lattice particles (bc/traction.hpp); the rings of the radial
-    // arrangement have none.
-    for (const auto& tc : config_.tractions)
-      for (const auto& b : config_.bodies)
-        if ((tc.body.empty() || tc.body == b.name) && b.arrangement == "radial")
-          throw std::invalid_argument(tc.where.str() + ": traction '" + tc.name + "' loads body '" + b.name +
-                                      "', whose arrangement is \"radial\": tractions load the faces of lattice "
-                                      "particles (arrangement = \"cartesian\"; docs/wls.md)");
-  }
   conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
   velocity_conditions_ = VelocityConditions<D>(config_, grid_, conditions_);
   if (comm.parallel() && !config_.tractions.empty()) {
@@ -221,9 +200,9 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     Particles<D> none;
     none.n_state_per_particle = particles_.n_state_per_particle;
     create_particles<D>(config_, grid_, materials_, mode_, none, &sites);
-    tractions_ = Tractions<D>(config_, grid_, particles_, face_domain, occupied, comm);
+    tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain(), occupied, comm);
   } else {
-    tractions_ = Tractions<D>(config_, grid_, particles_, face_domain);
+    tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
   }
   if (!config_.tractions.empty())
     on(StepPoint::after_forces, [this](double dt) {
@@ -234,12 +213,13 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
       });
     });
 
-  if (wls) {
+  if (config_.method.integration == "wls") {
     // The WLS method (seed 001) replaces the particle transfers; features that act through
     // them are not defined for it (docs/wls.md says why for each).
     const char* unsupported = D == 1                          ? "a 1D simulation"
                               : config_.contact.enabled()     ? "[contact]"
                               : config_.thermal.conduction    ? "[thermal] conduction"
+                              : !config_.tractions.empty()    ? "[[traction]]"
                                                               : nullptr;
     if (unsupported)
       throw std::invalid_argument(std::string("method.integration = \"wls\" does not support ") + unsupported +
@@ -310,28 +290,7 @@ void Simulation<D>::allocate_nodes() {
     compute_field_offsets();
   }
   if (!grid_.is_whole()) {
-    const bool wls = config_.method.integration == "wls";
-  ParticleDomain face_domain = shape_->particle_domain();
-  if (wls && !config_.tractions.empty()) {
-    // WLS: a face's nodal force is T A_s times the narrow shape S_i of seed 001 Eq. 5 at the
-    // face centre (the linear family's stencil of the face proxy, bc/traction.hpp); the face is
-    // convected by the particle's F, as the cut cells follow the deformed body. A face of a
-    // lattice particle with ppc particles per cell lies inside one cell, where S_i is linear
-    // (bilinear in 3D), so its centre value is the exact face average of S_i.
-    MethodConfig linear = config_.method;
-    linear.shape = "linear";
-    face_shape_ = make_shape_family<D>(ShapeContext{linear, D});  // (keeps nothing of the context)
-    face_domain = ParticleDomain::convected;
-    // Faces are those of lattice particles (bc/traction.hpp); the rings of the radial
-    // arrangement have none.
-    for (const auto& tc : config_.tractions)
-      for (const auto& b : config_.bodies)
-        if ((tc.body.empty() || tc.body == b.name) && b.arrangement == "radial")
-          throw std::invalid_argument(tc.where.str() + ": traction '" + tc.name + "' loads body '" + b.name +
-                                      "', whose arrangement is \"radial\": tractions load the faces of lattice "
-                                      "particles (arrangement = \"cartesian\"; docs/wls.md)");
-  }
-  conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
+    conditions_ = GridConditions<D>(config_.boundary, grid_, shape_->face_basis());
     VelocityConditions<D> window_conditions(config_, grid_, conditions_, false);
     window_conditions.take_state(std::move(velocity_conditions_));
     velocity_conditions_ = std::move(window_conditions);

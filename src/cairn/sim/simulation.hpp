@@ -298,10 +298,6 @@ class Simulation {
   TransferCache<D> cache_;
   std::vector<std::unique_ptr<Material>> materials_;
   std::unique_ptr<ShapeFamily<D>> shape_;
-  /// WLS runs: the linear family, whose S is the narrow shape of seed 001 Eq. 5, for the face
-  /// integrals of tractions (null otherwise: they use shape_).
-  std::unique_ptr<ShapeFamily<D>> face_shape_;
-  std::vector<Vec<D>> wls_loads_;  ///< WLS runs: the tractions' node forces of the step
   std::unique_ptr<UpdateScheme<D>> scheme_;
   std::unique_ptr<UpdateScheme<D>> flip_;
   std::unique_ptr<Conduction<D>> conduction_;  ///< [thermal] conduction = true

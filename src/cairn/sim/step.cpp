@@ -133,15 +133,6 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     return sim_.body_force_.empty() ? nullptr : &sim_.body_acceleration_;
   }
   std::vector<Vec<D>>* node_body_forces() override { return &sim_.node_body_force_; }
-  const std::vector<Vec<D>>* surface_loads(double dt) override {
-    if (sim_.tractions_.empty()) return nullptr;
-    // Tractions at t + dt/2 on the faces convected by F, integrated with the linear family's
-    // S, which is seed 001's narrow shape (Eq. 5): sim/simulation.cpp, bc/traction.hpp.
-    sim_.wls_loads_.assign(static_cast<std::size_t>(sim_.grid_.n_nodes()), Vec<D>::Zero());
-    sim_.tractions_.add_forces(sim_.grid_, sim_.particles_, *sim_.face_shape_, sim_.time_ + 0.5 * dt,
-                               sim_.wls_loads_);
-    return &sim_.wls_loads_;
-  }
   void prepare_conditions(double dt) override {
     sim_.velocity_conditions_.prepare(sim_.grid_, sim_.nodes_, sim_.small_mass_, sim_.time_, dt);
   }

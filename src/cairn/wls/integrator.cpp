@@ -187,8 +187,7 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
 template <int D>
 void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
                             const std::vector<double>& density0, const std::vector<Vec<D>>* body_acceleration,
-                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force,
-                            const std::vector<Vec<D>>* surface_force) {
+                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force) {
   const auto n = static_cast<std::int64_t>(particles.n());
   const bool body_force = body_acceleration != nullptr;
   const int n_used = body_force ? n_fields : n_fields - D;
@@ -263,7 +262,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
-  integrate(grid, body_force, nodes, node_body_force, surface_force);
+  integrate(grid, body_force, nodes, node_body_force);
 }
 
 template <int D>
@@ -543,7 +542,7 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
 
 template <int D>
 void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
-                              std::vector<Vec<D>>* node_body_force, const std::vector<Vec<D>>* surface_force) {
+                              std::vector<Vec<D>>* node_body_force) {
   const std::int32_t n_nodes = grid.n_nodes();
   // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
   for_each_node(n_nodes, [&](std::int32_t i) {
@@ -556,20 +555,13 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     });
     nodes.mass[i] = m;
     nodes.momentum[i] = m * velocity_[i];
-    // A traction's node force (seed 000 Sec. 2.4 with S of Eq. 5) is the surface term of the
-    // weak form whose volume term is Eq. 24: at a surface node in equilibrium the two cancel.
-    // It stays with Eq. 24 below, so that a spurious node (a sliver of a cut cell, whose mass
-    // shrinks faster than its share of the face) takes its neighbours' mean of both instead of
-    // being accelerated by its share of the load alone (docs/wls.md).
-    if (surface_force) fi += (*surface_force)[i];
     internal_force_[i] = fi;
     nodes.force[i] = fe;
     if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
     if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
   });
-  // Sec. 3.5 / 4.5: the internal force (with the surface loads) of a spurious node is the mean
-  // over its 3^D - 1 neighbours that are well conditioned and carry mass (per unit mass by
-  // default, docs/wls.md).
+  // Sec. 3.5 / 4.5: the internal force of a spurious node is the mean over its 3^D - 1
+  // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
   for_each_node(n_nodes, [&](std::int32_t i) {
     Vec<D> fi = internal_force_[i];
     if (!alpha_[i] && nodes.mass[i] > 0.0 && !options_.integrated_spurious_force) {

@@ -97,13 +97,10 @@ class Integrator {
 
   /// Sec. 4.1-4.5 into `nodes` (mass, momentum, force; velocities and reactions cleared) and,
   /// when given, the external part of the force into `node_body_force`. `density0[m]` is the
-  /// reference density of material m; `body_acceleration` (b_p, or null) the body force;
-  /// `surface_force` (or null) node forces of loads on the body's surface (tractions), which
-  /// join the internal force: the boundary term of the same weak-form stress integral, replaced
-  /// with it at spurious nodes (Sec. 3.5, 4.5; docs/wls.md).
+  /// reference density of material m; `body_acceleration` (b_p, or null) the body force.
   void collect(const Grid<D>& grid, const Particles<D>& particles, const std::vector<double>& density0,
                const std::vector<Vec<D>>* body_acceleration, NodeField<D>& nodes,
-               std::vector<Vec<D>>* node_body_force, const std::vector<Vec<D>>* surface_force = nullptr);
+               std::vector<Vec<D>>* node_body_force);
 
   /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
   /// x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
@@ -148,8 +145,7 @@ class Integrator {
   void extrapolate_spurious_velocity(const Grid<D>& grid);
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
-  void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force,
-                 const std::vector<Vec<D>>* surface_force);
+  void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force);
   /// fn(region index, region, S_iq, G_iq) for every region in the cells node i is a corner of.
   template <class Fn>
   void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;

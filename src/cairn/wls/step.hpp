@@ -22,10 +22,6 @@ class EngineStages {
   /// S^T M b part of the node forces goes.
   virtual const std::vector<Vec<D>>* body_accelerations() = 0;
   virtual std::vector<Vec<D>>* node_body_forces() = 0;
-  /// The node forces of the loads on the body's surface at t + dt/2 (null: none): tractions on
-  /// particle faces, f_i = sum_s T A_s S_i(face centre) (seed 000 Sec. 2.4 with the narrow shape
-  /// S of seed 001 Eq. 5 as N_i). They join Eq. 24 in Integrator::collect.
-  virtual const std::vector<Vec<D>>* surface_loads(double dt) = 0;
   /// The velocity conditions of this step, from the collected node masses.
   virtual void prepare_conditions(double dt) = 0;
   /// Eq. 25-26: v+ = v + a dt with the velocity conditions (half the first acceleration, Sec. 4.7).
