@@ -72,7 +72,7 @@ TEST(WlsConditions, MovingWallCompressesAHeldBar) {
   // The bar [0, 0.425] on a symmetry face, pushed at x = 0.425 by a wall that moves by -delta
   // with a smooth velocity history over 0.1 (eight wave transits) and then stops: the wall's
   // nodes move with the wall every step, and the bar ends uniformly compressed, sigma_xx =
-  // -E delta / L (measured 0.9 % below; the particles' stresses scatter by about 15 % of it).
+  // -E delta / L (measured 0.9 % below; the particles' stresses scatter by about 16 % of it).
   Config c = bar_config(2, 0.425, true);
   const double delta = 4.0e-4, t_r = 0.1;
   WallConfig w;
