@@ -8,7 +8,7 @@
 #include <map>
 #include <numbers>
 #include <string>
-#include <tuple>
+#include <array>
 
 #include "../support/config_builder.hpp"
 #include "cairn/sim/simulation.hpp"
@@ -17,7 +17,7 @@
 namespace cairn {
 namespace {
 
-constexpr double E = 1.0e6, rho = 1000.0;
+constexpr double E = 1.0e6;
 
 /// A WLS bar [0, L] x [0.275, 0.525] (x [0.275, 0.525] in 3D) on the grid [0, 1]^D, linear
 /// elastic with nu = 0 (plane strain: sigma_xx = E eps_xx, sigma_yy = 0 for a free strip),
@@ -115,18 +115,22 @@ TEST(WlsConditions, MovingWallCompressesAHeldBar) {
 // ---- periodic axes ------------------------------------------------------------------------------
 
 /// A box body of the WLS bar's material, as two boxes when it crosses x = 1 (the seam of the
-/// periodic x axis of [0, 1]^2), with the velocity field v(X - shift): a fast translation along
+/// periodic x axis of [0, 1]^D), with the velocity field v(X - shift): a fast translation along
 /// x, a periodic stretch and a shear.
-Config periodic_config(double shift) {
-  Config c = bar_config(2, 0.425, false);
+Config periodic_config(int D, double shift) {
+  Config c = bar_config(D, 0.425, false);
   c.boundary.face[0] = c.boundary.face[1] = FaceCondition::periodic;
   c.materials[0].numbers["poissons_ratio"] = 0.3;
+  if (D == 3) c.grid.cell_size.assign(D, 0.1);
   const std::string s = "(X - " + std::to_string(shift) + ")";
-  const std::vector<std::string> v = {"5 + 0.3 * sin(2 * pi * " + s + ")", "0.2 * cos(2 * pi * " + s + ") * (Y - 0.5)"};
+  std::vector<std::string> v = {"5 + 0.3 * sin(2 * pi * " + s + ")", "0.2 * cos(2 * pi * " + s + ") * (Y - 0.5)"};
+  if (D == 3) v.push_back("0.1 * sin(2 * pi * " + s + ") * (Z - 0.5)");
   BodyConfig body = c.bodies[0];
   body.velocity = v;
-  body.shape.min = {0.3 + shift, 0.3};
-  body.shape.max = {0.7 + shift, 0.6};
+  body.shape.min.assign(D, 0.3);
+  body.shape.max.assign(D, 0.6);
+  body.shape.min[0] = 0.3 + shift;
+  body.shape.max[0] = 0.7 + shift;
   c.bodies.clear();
   if (body.shape.max[0] <= 1.0) {
     c.bodies.push_back(body);
@@ -142,25 +146,31 @@ Config periodic_config(double shift) {
   return c;
 }
 
-TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
+template <int D>
+void check_periodic_seam(int steps) {
   // The same body, once in the middle of the grid and once shifted by half the periodic length
-  // (10 cells) so that the seam runs through it, for 40 steps in which its particles travel
-  // about 2 cells and those next to the seam cross it: every particle ends with the same velocity,
-  // stress and (up to the period) position, to round-off.
-  Simulation<2> away(periodic_config(0.0)), across(periodic_config(0.5));
+  // so that the seam runs through it, for `steps` steps in which its particles travel about
+  // 2 cells (2D; 1 in 3D) and those next to the seam cross it: every particle ends with the same
+  // velocity, stress and (up to the period) position, to round-off.
+  Simulation<D> away(periodic_config(D, 0.0)), across(periodic_config(D, 0.5));
   ASSERT_EQ(away.particles().n(), across.particles().n());
-  for (int s = 0; s < 40; ++s) {
+  for (int s = 0; s < steps; ++s) {
     const double dt = away.next_dt();  // (across.next_dt() differs by round-off: sin(2 pi (X - 0.5)))
     away.step(dt);
     across.step(dt);
   }
-  auto key = [](const Vec<2>& X) {
-    return std::make_tuple(std::llround(std::fmod(X[0] + 10.0, 1.0) * 1e6) % 1000000, std::llround(X[1] * 1e6));
+  auto key = [](const Vec<D>& X) {
+    std::array<long long, 3> k{};
+    k[0] = std::llround(std::fmod(X[0] + 10.0, 1.0) * 1e6) % 1000000;
+    for (int a = 1; a < D; ++a) k[a] = std::llround(X[a] * 1e6);
+    return k;
   };
-  std::map<std::tuple<long long, long long>, std::size_t> of;
+  std::map<std::array<long long, 3>, std::size_t> of;
   const auto& A = away.particles();
   const auto& B = across.particles();
-  for (std::size_t p = 0; p < A.n(); ++p) of[key(A.reference_position[p] + Vec<2>(0.5, 0.0))] = p;
+  Vec<D> half = Vec<D>::Zero();
+  half[0] = 0.5;
+  for (std::size_t p = 0; p < A.n(); ++p) of[key(A.reference_position[p] + half)] = p;
   ASSERT_EQ(of.size(), A.n());
   double dx = 0.0, dv = 0.0, ds = 0.0, v_max = 0.0, s_max = 0.0;
   int crossed = 0;
@@ -168,7 +178,7 @@ TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
     const auto it = of.find(key(B.reference_position[q]));
     ASSERT_NE(it, of.end()) << q;
     const std::size_t p = it->second;
-    Vec<2> d = B.position[q] - A.position[p] - Vec<2>(0.5, 0.0);
+    Vec<D> d = B.position[q] - A.position[p] - half;
     d[0] -= std::round(d[0]);  // the period is 1
     dx = std::max(dx, d.norm());
     dv = std::max(dv, (B.velocity[q] - A.velocity[p]).norm());
@@ -177,8 +187,8 @@ TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
     s_max = std::max(s_max, A.kirchhoff_stress[p].full().norm());
     crossed += B.reference_position[q][0] < 1.0 && B.position[q][0] > 1.0;
   }
-  std::printf("periodic seam: %d particles crossed; max differences: position %.3g, velocity %.3g (of %.3g), "
-              "stress %.3g (of %.3g)\n", crossed, dx, dv, v_max, ds, s_max);
+  std::printf("periodic seam (%dD): %d particles crossed; max differences: position %.3g, velocity %.3g (of %.3g), "
+              "stress %.3g (of %.3g)\n", D, crossed, dx, dv, v_max, ds, s_max);
   EXPECT_GT(crossed, 10);
   EXPECT_GT(s_max, 10.0);  // the body deforms
   EXPECT_LT(dx, 1e-12);
@@ -186,8 +196,13 @@ TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
   EXPECT_LT(ds, 1e-9 * s_max);
 }
 
+TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
+  ASSERT_NO_FATAL_FAILURE(check_periodic_seam<2>(40));
+  ASSERT_NO_FATAL_FAILURE(check_periodic_seam<3>(20));
+}
+
 TEST(WlsConditions, PeriodicAxisNeedsThreeCells) {
-  Config c = periodic_config(0.0);
+  Config c = periodic_config(2, 0.0);
   c.grid.extent[0] = 0.1;  // two cells
   c.bodies[0].shape.min[0] = 0.0;
   c.bodies[0].shape.max[0] = 0.1;
