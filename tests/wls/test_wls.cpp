@@ -659,6 +659,9 @@ TEST(WlsIntegration, RejectsFeaturesItDoesNotDefine) {
   Config c = wls_config(2, "circle", 0.05);
   c.contact.mode = "material";
   EXPECT_THROW(Simulation<2>{c}, std::invalid_argument);
+  Config hot = wls_config(2, "circle", 0.05);
+  hot.thermal.conduction = true;
+  EXPECT_THROW(Simulation<2>{hot}, std::invalid_argument);
   Config one = test::box_config(1, "linear");
   one.method.integration = "wls";
   EXPECT_THROW(Simulation<1>{one}, std::invalid_argument);

@@ -215,18 +215,22 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
 
   if (config_.method.integration == "wls") {
     // The WLS method (seed 001) replaces the particle transfers; features that act through
-    // them are not defined for it.
+    // them are not defined for it (docs/wls.md says why for each).
     const char* unsupported = D == 1                          ? "a 1D simulation"
                               : config_.contact.enabled()     ? "[contact]"
                               : config_.thermal.conduction    ? "[thermal] conduction"
                               : !config_.tractions.empty()    ? "[[traction]]"
-                              : !config_.walls.empty()        ? "[[wall]]"
                                                               : nullptr;
-    for (int a = 0; a < D && !unsupported; ++a)
-      if (grid_.periodic(a)) unsupported = "periodic faces";
     if (unsupported)
       throw std::invalid_argument(std::string("method.integration = \"wls\" does not support ") + unsupported +
                                   " (docs/wls.md)");
+    // Periodic axes wrap the stencils, fits, neighbour averages and cut cells; the 3 nodes of a
+    // stencil along the axis must be distinct nodes.
+    for (int a = 0; a < D; ++a)
+      if (grid_.periodic(a) && grid_.n_cells()[a] < 3)
+        throw std::invalid_argument(std::string("method.integration = \"wls\" needs at least 3 cells along the "
+                                                "periodic ") +
+                                    "xyz"[a] + " axis (its stencils span 3 nodes; docs/wls.md)");
     wls::Options o = wls::options(config_.method);
     // A symmetry face is a mirror plane of the body when the body reaches it at the start
     // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).

@@ -76,6 +76,10 @@ void corner_shape(int corner, const Vec<D>& xi, const Vec<D>& inv_h, double& S, 
 template <int D>
 Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
     : options_(options), h_(grid.cell_size()), n_cells_(grid.n_cells()) {
+  for (int a = 0; a < D; ++a) {
+    periodic_[a] = grid.periodic(a);
+    any_periodic_ |= periodic_[a];
+  }
   const std::int32_t n = grid.n_nodes();
   moment_.assign(n, {});
   load_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
@@ -119,7 +123,10 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
       bool outside = false;
       for (int a = 0; a < D; ++a) {
         cell[a] = static_cast<int>(std::floor(xi[a]));
-        outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
+        // A periodic axis does not wrap the positions (sim/resources.cpp): every cell index is
+        // inside, and axis_index wraps the nodes; r below is then measured to the node's image
+        // next to the particle.
+        if (!periodic_[a]) outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
         const int nearest = static_cast<int>(std::floor(xi[a] + 0.5));
         const double local = xi[a] - cell[a];
         for (int k = 0; k < 3; ++k) {
@@ -217,7 +224,15 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
       const bool surface = is_surface(particles, static_cast<std::size_t>(p));
       beta_[i] += S * (surface ? 1.0 : 2.0);
       if (surface) {
-        surface_sum_[i] += S * particles.position[p];
+        // Along a periodic axis the particle's image next to the node (x_i + r h), so that
+        // x_surf of a node on the seam averages the particles on both sides of it.
+        Vec<D> x = particles.position[p];
+        if (any_periodic_) {
+          const Vec<D> xi = grid.node_position(i);
+          for (int a = 0; a < D; ++a)
+            if (periodic_[a]) x[a] = xi[a] + offset_[s][a] * h_[a];
+        }
+        surface_sum_[i] += S * x;
         surface_weight_[i] += S;
       }
     }
@@ -509,6 +524,7 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
     bool inside = true;
     for (int a = 0; a < D; ++a) {
       cell[a] -= (k >> a) & 1;
+      if (periodic_[a] && cell[a] < 0) cell[a] += n_cells_[a];  // node 0's lower cell: the last one
       inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
     }
     if (!inside) continue;

@@ -154,6 +154,8 @@ class Integrator {
   Options options_;
   Vec<D> h_;
   IVec<D> n_cells_;
+  std::array<bool, D> periodic_{};  ///< the grid wraps the axis (positions are not wrapped)
+  bool any_periodic_ = false;
   TransferCache<D> cache_;             ///< node, weight = W, gradient = G per stencil slot
   std::vector<double> shape_;          ///< S per stencil slot
   std::vector<Vec<D>> offset_;         ///< x_p - x_i in cells per stencil slot
