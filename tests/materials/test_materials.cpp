@@ -256,5 +256,51 @@ TEST(Materials, PlaneStressSolvesForTheOutOfPlaneStretch) {
   }
 }
 
+// A path-dependent model that reads the step's increment (Mie-Grueneisen: radial return on the
+// elastic left stretch, internal energy in its state) under plane stress: every Newton trial of
+// F_zz starts from the state before the step and sees the increment dF_zz that F_zz implies. (It
+// did not: each trial fed its state to the next and kept dF_zz = 1, and a copper wedge in plane
+// stress failed with det F = -196 in its third step, tests/robustness/corpus/contact_2d.toml.)
+TEST(Materials, PlaneStressOfAPathDependentModelStartsEveryTrialFromTheStateBeforeTheStep) {
+  MaterialConfig c = config("mie_gruneisen", {{"bulk_modulus", 1.37e11}, {"shear_modulus", 4.6e10},
+                                              {"gamma0", 2.0}, {"s1", 1.49}, {"yield_stress", 1e8},
+                                              {"hardening_modulus", 0.0}, {"hardening_exponent", 0.0},
+                                              {"hardening_strain", 1.0}, {"av_a1", 0.0}, {"av_a2", 0.0},
+                                              {"heat_capacity", 385.0}, {"initial_temperature", 300.0}});
+  c.numbers["density"] = 8930.0;
+  c.strings["hardening"] = "linear";
+  auto m = make_material(c);
+  std::vector<double> before(static_cast<std::size_t>(m->n_state()));
+  m->initialize_state(before.data());
+  std::vector<double> state = before;
+  double temperature = m->initial_temperature();
+  const double dt = 1e-6, strain = -1e-4;  // uniaxial strain along x in the plane (elastic)
+  Mat3 L = Mat3::Zero();
+  L(0, 0) = std::log1p(strain) / dt;
+  Mat3 dF = Mat3::Identity();
+  dF(0, 0) = 1.0 + strain;
+  Mat3 F = dF;
+  const SymMat3 tau_old{};
+  MaterialPoint point{F, L, state.data(), dt, &dF, &tau_old, 0.01, &temperature, true};
+  const Mat3 tau = plane_stress_update(*m, F, point);
+  // Small strain: eps_zz = -lambda / (lambda + 2G) eps_xx, sigma_xx = (lambda' + 2G) eps_xx
+  // with lambda' = 2 G lambda / (lambda + 2G).
+  const double G = 4.6e10, lambda = 1.37e11 - 2.0 * G / 3.0;
+  EXPECT_NEAR(tau(2, 2), 0.0, 1e-9 * std::abs(tau(0, 0)));
+  EXPECT_NEAR(F(2, 2) - 1.0, -lambda / (lambda + 2.0 * G) * strain, 0.01 * std::abs(strain));
+  EXPECT_NEAR(tau(0, 0), (2.0 * G * lambda / (lambda + 2.0 * G) + 2.0 * G) * strain, 0.01 * 2.0 * G * std::abs(strain));
+  // The state it leaves is that of one update with the converged F_zz and its increment.
+  std::vector<double> once = before;
+  double temperature_once = m->initial_temperature();
+  Mat3 dF_once = dF, L_once = L;
+  dF_once(2, 2) = F(2, 2);
+  L_once(2, 2) = std::log(F(2, 2)) / dt;
+  const Mat3 tau_once =
+      m->update(MaterialPoint{F, L_once, once.data(), dt, &dF_once, &tau_old, 0.01, &temperature_once, true});
+  for (std::size_t k = 0; k < once.size(); ++k) EXPECT_NEAR(state[k], once[k], 1e-12 * (1.0 + std::abs(once[k]))) << k;
+  EXPECT_NEAR(temperature, temperature_once, 1e-12 * temperature_once);
+  EXPECT_NEAR((tau - tau_once).norm(), 0.0, 1e-12 * tau.norm());
+}
+
 }  // namespace
 }  // namespace cairn
