@@ -101,8 +101,10 @@ int checkpoint_dimension(const std::filesystem::path& path);
 void check_readable_by_hdf5(const std::filesystem::path& path);
 /// The engine that wrote a Cairn checkpoint of any engine (its `engine` attribute; files written
 /// before engines had names: "fem" for the FEM's format, else "mpm"). Throws InputError, as
-/// read_checkpoint does, for a file that is missing or not HDF5.
-std::string checkpoint_engine(const std::filesystem::path& path);
+/// read_checkpoint does, for a file that is missing or not HDF5. On several ranks (`comm`) rank 0
+/// alone checks the file (check_readable_by_hdf5 reads all of it) and every rank gets its answer
+/// or its error (std::invalid_argument with the same message).
+std::string checkpoint_engine(const std::filesystem::path& path, const Comm& comm = Comm::serial());
 
 /// The run-loop scalar `name` stored in the checkpoint `path` (its /scalars); InputError naming
 /// the file and /scalars/names when it is missing. stored_count: the same for a count (a whole

@@ -241,7 +241,7 @@ std::unique_ptr<Engine> restore_engine(const std::filesystem::path& checkpoint,
     for (char c : folder) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
     all.push_back("output.directory=" + quoted + "\"");
   }
-  const std::string engine = checkpoint_engine(checkpoint);
+  const std::string engine = checkpoint_engine(checkpoint, Comm::world());
   const auto names = EngineRegistry::instance().names();
   if (std::find(names.begin(), names.end(), engine) == names.end()) {
     std::string list;
