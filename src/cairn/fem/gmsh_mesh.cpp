@@ -87,7 +87,7 @@ class Bytes {
  private:
   void take(void* out, std::size_t n) {
     if (at_ + n > data_.size()) throw std::runtime_error("the Gmsh reading process sent a short answer");
-    std::memcpy(out, data_.data() + at_, n);
+    if (n > 0) std::memcpy(out, data_.data() + at_, n);  // (an empty vector's data() may be null)
     at_ += n;
   }
   std::string data_;

@@ -245,7 +245,7 @@ std::shared_ptr<const PointSet> read_point_h5_in_child(const std::string& path, 
   std::size_t at = 1;
   auto take = [&](void* p, std::size_t n) {
     if (at + n > r.output.size()) throw std::invalid_argument(fmt::format("point file '{}': a short answer", path));
-    std::memcpy(p, r.output.data() + at, n);
+    if (n > 0) std::memcpy(p, r.output.data() + at, n);  // (an empty vector's data() may be null)
     at += n;
   };
   auto set = std::make_shared<PointSet>();

@@ -329,7 +329,7 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
     std::size_t at = 0;
     auto take = [&](void* p, std::size_t n) {
       if (at + n > soup.output.size()) fail(path, "CGAL's reader process sent a short answer");
-      std::memcpy(p, soup.output.data() + at, n);
+      if (n > 0) std::memcpy(p, soup.output.data() + at, n);  // (an empty vector's data() may be null)
       at += n;
     };
     std::uint64_t flags[3];
