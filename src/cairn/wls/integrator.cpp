@@ -18,6 +18,23 @@ namespace {
 
 constexpr int pow3(int d) { return d == 0 ? 1 : 3 * pow3(d - 1); }
 
+/// fn(k) for the 3^D entries k (the node index along each axis, 0..2) of a WLS stencil, axis 0
+/// fastest: the order of the sums, the same for every particle. Inlined with its callers' bodies
+/// (GCC kept them out of line, with every captured pointer reloaded per entry).
+template <int D, class Fn>
+[[gnu::always_inline]] inline void for_each_slot(Fn&& fn) {
+  if constexpr (D == 1) {
+    for (int i = 0; i < 3; ++i) fn(std::array<int, 1>{i});
+  } else if constexpr (D == 2) {
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) fn(std::array<int, 2>{i, j});
+  } else {
+    for (int l = 0; l < 3; ++l)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) fn(std::array<int, 3>{i, j, l});
+  }
+}
+
 /// fn(nb, offset) for every node nb of the 3^D block around node i (itself included) that the
 /// grid holds; offset = position of nb minus that of i, in cells.
 template <int D, class Fn>
@@ -82,7 +99,7 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   }
   const std::int32_t n = grid.n_nodes();
   moment_.assign(n, {});
-  load_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
+  load_.assign(static_cast<std::size_t>(n) * n_basis * n_row, 0.0);
   coef_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
   max_weight_.assign(n, 0.0);
   count_.assign(n, 0);
@@ -104,11 +121,14 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
 
 template <int D>
 void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& particles) {
-  constexpr int slots = pow3(D);
+  // Per axis and particle the three nodes around the nearest one: their storage offsets and the
+  // narrow S, G factors in the cache's tensor layout (S_pi = prod_a S_a, G_pi,b = prod_a (a == b ?
+  // G_a : S_a)), the wide W factors and x_p - x_i in cells here; the 3^D products are formed
+  // where they are used (W, S and G are tensor products, seed 001 Sec. 3.1).
   const auto n = static_cast<std::int64_t>(particles.n());
-  cache_.reserve(particles.n(), slots);
-  shape_.resize(static_cast<std::size_t>(n) * slots);
-  offset_.resize(static_cast<std::size_t>(n) * slots);
+  cache_.reserve_tensor(particles.n(), 3);
+  wide_.resize(static_cast<std::size_t>(n) * D * 3);
+  offset_.resize(static_cast<std::size_t>(n) * D * 3);
   const Vec<D> inv_h = h_.cwiseInverse();
   std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
 #pragma omp parallel
@@ -117,56 +137,30 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
 #pragma omp for schedule(static)
     for (std::int64_t p = 0; p < n; ++p) {
       const Vec<D> xi = grid.to_cell_units(particles.position[p]);
-      IVec<D> cell;
-      std::array<std::array<double, 3>, D> w{}, s{}, g{}, r{};
-      std::array<std::array<std::int32_t, 3>, D> off{};
+      const std::size_t q = static_cast<std::size_t>(p) * D * 3;
       bool outside = false;
       for (int a = 0; a < D; ++a) {
-        cell[a] = static_cast<int>(std::floor(xi[a]));
+        const int cell = static_cast<int>(std::floor(xi[a]));
         // A periodic axis does not wrap the positions (sim/resources.cpp): every cell index is
         // inside, and axis_index wraps the nodes; r below is then measured to the node's image
         // next to the particle.
-        if (!periodic_[a]) outside |= !(cell[a] >= 0 && cell[a] < n_cells_[a]);
+        if (!periodic_[a]) outside |= !(cell >= 0 && cell < n_cells_[a]);
         const int nearest = static_cast<int>(std::floor(xi[a] + 0.5));
-        const double local = xi[a] - cell[a];
+        const double local = xi[a] - cell;
+        std::int32_t* node = &cache_.axis_node[q + 3 * a];
+        double* S = &cache_.axis_value[2 * q + 6 * a];
         for (int k = 0; k < 3; ++k) {
           const int j = nearest - 1 + k;
-          r[a][k] = xi[a] - j;                       // x_p - x_i in cells
-          w[a][k] = wide_weight(r[a][k], 1.0);       // Eq. 4
-          s[a][k] = j == cell[a] ? 1.0 - local : j == cell[a] + 1 ? local : 0.0;  // Eq. 5
-          g[a][k] = j == cell[a] ? -inv_h[a] : j == cell[a] + 1 ? inv_h[a] : 0.0;  // Eq. 6
-          off[a][k] = grid.axis_index(a, j);
-          outside |= off[a][k] < 0;
+          const double r = xi[a] - j;                                      // x_p - x_i in cells
+          offset_[q + 3 * a + k] = r;
+          wide_[q + 3 * a + k] = wide_weight(r, 1.0);                      // Eq. 4
+          S[k] = j == cell ? 1.0 - local : j == cell + 1 ? local : 0.0;     // Eq. 5
+          S[3 + k] = j == cell ? -inv_h[a] : j == cell + 1 ? inv_h[a] : 0.0;  // Eq. 6
+          node[k] = grid.axis_index(a, j);
+          outside |= node[k] < 0;
         }
       }
-      cache_.count[p] = static_cast<std::uint16_t>(slots);
-      if (outside) {
-        bad_t = std::min(bad_t, p);
-        continue;
-      }
-      const std::size_t base = static_cast<std::size_t>(p) * slots;
-      std::array<int, D> k{};
-      for (int slot = 0; slot < slots; ++slot) {
-        double W = 1.0, S = 1.0;
-        Vec<D> G = Vec<D>::Ones(), rr;
-        std::int32_t idx = 0;
-        for (int a = 0; a < D; ++a) {
-          W *= w[a][k[a]];
-          S *= s[a][k[a]];
-          for (int b = 0; b < D; ++b) G[b] *= (a == b) ? g[a][k[a]] : s[a][k[a]];
-          rr[a] = r[a][k[a]];
-          idx += off[a][k[a]];
-        }
-        for (int a = 0; a < D; ++a) {
-          if (++k[a] < 3) break;
-          k[a] = 0;
-        }
-        cache_.node[base + slot] = idx;
-        cache_.weight[base + slot] = W;
-        cache_.gradient[base + slot] = G;
-        shape_[base + slot] = S;
-        offset_[base + slot] = rr;
-      }
+      if (outside) bad_t = std::min(bad_t, p);
     }
 #pragma omp critical(cairn_wls_stencil)
     first_bad = std::min(first_bad, bad_t);
@@ -191,24 +185,25 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   const auto n = static_cast<std::int64_t>(particles.n());
   const bool body_force = body_acceleration != nullptr;
   const int n_used = body_force ? n_fields : n_fields - D;
-  // Sec. 4.1: J_p, rho_p = rho0 / J_p, sigma_p = tau_p / J_p, f_p = rho_p b_p.
-  particle_fields_.resize(static_cast<std::size_t>(n) * n_fields);
+  // Sec. 4.1: J_p, rho_p = rho0 / J_p, sigma_p = tau_p / J_p, f_p = rho_p b_p; a row of n_row
+  // values per particle (the fields, padded with zeros to pairs).
+  particle_fields_.resize(static_cast<std::size_t>(n) * n_row);
 #pragma omp parallel for schedule(static)
   for (std::int64_t p = 0; p < n; ++p) {
-    double* f = &particle_fields_[static_cast<std::size_t>(p) * n_fields];
+    double* f = &particle_fields_[static_cast<std::size_t>(p) * n_row];
     const double J = particles.deformation_gradient[p].determinant();
     const double rho = density0[particles.material[p]] / J;
     for (int a = 0; a < D; ++a) f[a] = particles.velocity[p][a];
     f[D] = rho;
     for (int a = 0; a < D; ++a)
       for (int b = a; b < D; ++b) f[D + 1 + voigt<D>(a, b)] = particles.kirchhoff_stress[p](a, b) / J;
-    if (body_force)
-      for (int a = 0; a < D; ++a) f[D + 1 + n_stress + a] = rho * (*body_acceleration)[p][a];
+    for (int a = 0; a < D; ++a) f[D + 1 + n_stress + a] = body_force ? rho * (*body_acceleration)[p][a] : 0.0;
+    for (int k = n_fields; k < n_row; ++k) f[k] = 0.0;
   }
   const std::int32_t n_nodes = grid.n_nodes();
   for_each_node(n_nodes, [&](std::int32_t i) {
     moment_[i].fill(0.0);
-    std::fill_n(&load_[static_cast<std::size_t>(i) * n_fields * n_basis], n_fields * n_basis, 0.0);
+    std::fill_n(&load_[static_cast<std::size_t>(i) * n_basis * n_row], n_basis * n_row, 0.0);
     max_weight_[i] = 0.0;
     count_[i] = 0;
     beta_[i] = 0.0;
@@ -216,48 +211,73 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     surface_weight_[i] = 0.0;
   });
   // Moment matrices and load vectors (Eq. 9) with the wide weight; particle flags (Eq. 13) and
-  // surface positions (Eq. 15) with the narrow shape.
-  auto entry = [&](std::int32_t p, std::size_t s) {
-    const std::int32_t i = cache_.node[s];
-    const double S = shape_[s];
-    if (S != 0.0) {
+  // surface positions (Eq. 15) with the narrow shape. The loads are summed in pairs of fields
+  // (GCC/Clang vector extensions, SSE2: the same operations per field), over a compile-time
+  // number of pairs (with and without the body-force density).
+  using Pair = double __attribute__((vector_size(16), may_alias));
+  auto sums = [&]<int n_pair>() {
+    scatter(cache_, [&](std::int32_t p, const auto&) {
+      const std::size_t q = static_cast<std::size_t>(p) * D * 3;
+      const std::int32_t* axis_node = &cache_.axis_node[q];
+      const double* axis_S = &cache_.axis_value[2 * q];
+      const double* axis_W = &wide_[q];
+      const double* axis_r = &offset_[q];
       const bool surface = is_surface(particles, static_cast<std::size_t>(p));
-      beta_[i] += S * (surface ? 1.0 : 2.0);
-      if (surface) {
-        // Along a periodic axis the particle's image next to the node (x_i + r h), so that
-        // x_surf of a node on the seam averages the particles on both sides of it.
-        Vec<D> x = particles.position[p];
-        if (any_periodic_) {
-          const Vec<D> xi = grid.node_position(i);
-          for (int a = 0; a < D; ++a)
-            if (periodic_[a]) x[a] = xi[a] + offset_[s][a] * h_[a];
+      const double flag = surface ? 1.0 : 2.0;
+      const Vec<D>& x_p = particles.position[p];
+      const Pair* f = reinterpret_cast<const Pair*>(&particle_fields_[static_cast<std::size_t>(p) * n_row]);
+      for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
+        std::int32_t i = 0;
+        double W = 1.0, S = 1.0;
+        for (int a = 0; a < D; ++a) {
+          i += axis_node[3 * a + k[a]];
+          W *= axis_W[3 * a + k[a]];
+          S *= axis_S[6 * a + k[a]];
         }
-        surface_sum_[i] += S * x;
-        surface_weight_[i] += S;
-      }
-    }
-    const double W = cache_.weight[s];
-    if (W <= 0.0) return;
-    const auto b = PlaneFit<D>::basis(offset_[s]);
-    auto& M = moment_[i];
-    for (int r = 0; r < n_basis; ++r)
-      for (int c = r; c < n_basis; ++c) M[packed(r, c, n_basis)] += W * b[r] * b[c];
-    const double* f = &particle_fields_[static_cast<std::size_t>(p) * n_fields];
-    double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
-    for (int k = 0; k < n_used; ++k) {
-      const double wf = W * f[k];
-      for (int r = 0; r < n_basis; ++r) l[k * n_basis + r] += wf * b[r];
-    }
-    max_weight_[i] = std::max(max_weight_[i], W);
-    ++count_[i];
+        // The basis [1, r] at r = x_p - x_i in cells (PlaneFit::basis), as scalars: kept in an
+        // array, the compiler stored its entries one by one and loaded them back in pairs (a
+        // store-forwarding stall that took a quarter of the scatter).
+        const double r0 = axis_r[k[0]];
+        const double r1 = D > 1 ? axis_r[3 + k[D > 1 ? 1 : 0]] : 0.0;
+        const double r2 = D > 2 ? axis_r[6 + k[D > 2 ? 2 : 0]] : 0.0;
+        const auto b = [&](int r) { return r == 0 ? 1.0 : r == 1 ? r0 : r == 2 ? r1 : r2; };
+        beta_[i] += S * flag;  // adds zero where S = 0
+        if (surface && S != 0.0) {
+          // Along a periodic axis the particle's image next to the node (x_i + r h), so that
+          // x_surf of a node on the seam averages the particles on both sides of it.
+          Vec<D> x = x_p;
+          if (any_periodic_) {
+            const Vec<D> xi = grid.node_position(i);
+            for (int a = 0; a < D; ++a)
+              if (periodic_[a]) x[a] = xi[a] + b(1 + a) * h_[a];
+          }
+          surface_sum_[i] += S * x;
+          surface_weight_[i] += S;
+        }
+        if (W <= 0.0) return;
+        auto& M = moment_[i];
+        for (int r = 0; r < n_basis; ++r)
+          for (int c = r; c < n_basis; ++c) M[packed(r, c, n_basis)] += W * b(r) * b(c);
+        // Per basis function a row of the fields: l_rk += (W f_k) b_r, along the row in pairs.
+        Pair* l = reinterpret_cast<Pair*>(&load_[static_cast<std::size_t>(i) * n_basis * n_row]);
+        const Pair W2 = {W, W};
+        for (int m = 0; m < n_pair; ++m) {
+          const Pair wf = W2 * f[m];
+          for (int r = 0; r < n_basis; ++r) {
+            const Pair b2 = {b(r), b(r)};
+            l[r * (n_row / 2) + m] += wf * b2;
+          }
+        }
+        max_weight_[i] = std::max(max_weight_[i], W);
+        ++count_[i];
+      });
+    });
   };
-  // The list-layout cache holds all 3^D slots of every particle; shape_ and offset_ share its
-  // slot numbering.
-  constexpr int slots = pow3(D);
-  scatter(cache_, [&](std::int32_t p, const auto&) {
-    const std::size_t base = static_cast<std::size_t>(p) * slots;
-    for (std::size_t s = base; s < base + slots; ++s) entry(p, s);
-  });
+  if (body_force) {
+    sums.template operator()<(n_fields + 1) / 2>();
+  } else {
+    sums.template operator()<(n_fields - D + 1) / 2>();
+  }
   fit_nodes(grid, n_used);
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
@@ -306,10 +326,10 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     inverse_[i] = PlaneFit<D>::inverse(M, reduce, &reduced);
     alpha_[i] = reduced ? 0 : 1;
     if (reduced) ++spurious[static_cast<std::size_t>(omp_get_thread_num())];
-    const double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
+    const double* l = &load_[static_cast<std::size_t>(i) * n_basis * n_row];
     for (int k = 0; k < n_used; ++k)  // c = M^-1 l of field k (Eq. 10); zero slopes where reduced
       for (int c = 0; c < n_basis; ++c)
-        for (int r = 0; r < n_basis; ++r) coef[k * n_basis + c] += inverse_[i](c, r) * l[k * n_basis + r];
+        for (int r = 0; r < n_basis; ++r) coef[k * n_basis + c] += inverse_[i](c, r) * l[r * n_row + k];
     auto value = [&](int k) { return coef[k * n_basis]; };  // c0 of field k (Eq. 11)
     for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
     density_[i] = value(D);
@@ -325,11 +345,11 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
 template <int D>
 Eigen::Matrix<double, D, D> Integrator<D>::velocity_gradient_fit(std::int32_t i) const {
   Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-  const double* l = &load_[static_cast<std::size_t>(i) * n_fields * n_basis];
+  const double* l = &load_[static_cast<std::size_t>(i) * n_basis * n_row];
   for (int a = 0; a < D; ++a)
     for (int b = 0; b < D; ++b) {
       double c = 0.0;
-      for (int r = 0; r < n_basis; ++r) c += inverse_[i](1 + b, r) * l[a * n_basis + r];
+      for (int r = 0; r < n_basis; ++r) c += inverse_[i](1 + b, r) * l[r * n_row + a];
       L(a, b) = c / h_[b];  // Eq. 12, back from cell units
     }
   return L;
@@ -659,27 +679,35 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const auto& v_new = nodes.velocity_new;
   const bool from_quadrature = options_.quadrature_gradient;
   if (from_quadrature) quadrature_gradients(grid, v_new);
-  constexpr int slots = pow3(D);
   particle_gradient_.resize(particles.n());
   gather(cache_, [&](std::int64_t p, const auto&) {
-    const std::size_t begin = static_cast<std::size_t>(p) * slots, end = begin + slots;
+    const std::size_t q = static_cast<std::size_t>(p) * D * 3;
+    const std::int32_t* axis_node = &cache_.axis_node[q];
+    const double* axis_S = &cache_.axis_value[2 * q];
     Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
     double weight = 0.0;
-    for (std::size_t s = begin; s < end; ++s) {
-      const std::int32_t i = cache_.node[s];
-      const double S = shape_[s];
+    for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
+      std::int32_t i = 0;
+      double S = 1.0;
+      for (int a = 0; a < D; ++a) {
+        i += axis_node[3 * a + k[a]];
+        S *= axis_S[6 * a + k[a]];
+      }
       dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
       vx += S * v_new[i];           // Eq. 28
       if (!from_quadrature) {
-        L += v_new[i] * cache_.gradient[s].transpose();  // Eq. 29
+        Vec<D> G = Vec<D>::Ones();  // G_ip,b = prod_a (a == b ? G_a : S_a)
+        for (int a = 0; a < D; ++a)
+          for (int c = 0; c < D; ++c) G[c] *= a == c ? axis_S[6 * a + 3 + k[a]] : axis_S[6 * a + k[a]];
+        L += v_new[i] * G.transpose();  // Eq. 29
       } else if (node_gradient_weight_[i] > 0.0) {
         // S-interpolated node means of the integration points' gradients (docs/wls.md), over
         // the nodes that have integration points around them.
         L += S * node_gradient_[i];
         weight += S;
       }
-    }
+    });
     if (from_quadrature && weight > 0.0) L /= weight;
     particles.velocity[p] += dv;
     particles.position[p] += vx * dt;

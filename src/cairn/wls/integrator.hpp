@@ -91,8 +91,8 @@ class Integrator {
   Integrator(const Grid<D>& grid, const Options& options);
   [[nodiscard]] const Options& options() const { return options_; }
 
-  /// W, S and G of every particle over the 3^D nodes around its nearest node, and the
-  /// colouring of the scatter. Throws SimulationFailure when a particle left the grid.
+  /// W, S and G of every particle over the 3^D nodes around its nearest node. Throws
+  /// SimulationFailure when a particle left the grid.
   void build_stencils(const Grid<D>& grid, const Particles<D>& particles);
 
   /// Sec. 4.1-4.5 into `nodes` (mass, momentum, force; velocities and reactions cleared) and,
@@ -140,6 +140,8 @@ class Integrator {
   static constexpr int n_stress = D * (D + 1) / 2;
   /// Fields fitted per node: velocity (D), density (1), stress (D(D+1)/2), body-force density (D).
   static constexpr int n_fields = 2 * D + 1 + n_stress;
+  /// Fields per row of the sums, padded to pairs (the scatter adds two fields at a time).
+  static constexpr int n_row = n_fields + n_fields % 2;
 
   void fit_nodes(const Grid<D>& grid, int n_used_fields);
   void extrapolate_spurious_velocity(const Grid<D>& grid);
@@ -156,13 +158,13 @@ class Integrator {
   IVec<D> n_cells_;
   std::array<bool, D> periodic_{};  ///< the grid wraps the axis (positions are not wrapped)
   bool any_periodic_ = false;
-  TransferCache<D> cache_;             ///< node, weight = W, gradient = G per stencil slot
-  std::vector<double> shape_;          ///< S per stencil slot
-  std::vector<Vec<D>> offset_;         ///< x_p - x_i in cells per stencil slot
-  std::vector<double> particle_fields_;///< n x n_fields per-particle values of the step
+  TransferCache<D> cache_;             ///< tensor layout, width 3: node offsets, S and G per axis
+  std::vector<double> wide_;           ///< n x D x 3: W per axis (Eq. 4)
+  std::vector<double> offset_;         ///< n x D x 3: x_p - x_i in cells per axis
+  std::vector<double> particle_fields_;///< n x n_row per-particle values of the step
   // node accumulators and results
   std::vector<std::array<double, n_moment>> moment_;
-  std::vector<double> load_;           ///< n_nodes x n_fields x n_basis
+  std::vector<double> load_;           ///< n_nodes x n_basis x n_row (l of Eq. 9, field fastest)
   std::vector<double> max_weight_;
   std::vector<std::int32_t> count_;
   std::vector<double> beta_;
