@@ -112,6 +112,7 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   stress_.assign(n, Eigen::Matrix<double, D, D>::Zero());
   inverse_.assign(n, Eigen::Matrix<double, n_basis, n_basis>::Zero());
   alpha_.assign(n, 0);
+  live_.assign(n, 1);  // every node is fitted at the first step
   distance_.assign(n, 0.0);
   internal_force_.assign(n, Vec<D>::Zero());
   long long cells = 1;
@@ -291,6 +292,10 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
   const double h = grid.min_cell_size();
   std::vector<long long> spurious(static_cast<std::size_t>(omp_get_max_threads()), 0);
   for_each_node(n_nodes, [&](std::int32_t i) {
+    // A node no particle reaches, now or at the last fit, keeps what that fit left: beta = 0,
+    // distance -h, no surface position, zero values and coefficients (about half the nodes).
+    if (count_[i] == 0 && !live_[i]) return;
+    live_[i] = count_[i] > 0;
     // Flags summed over the mirror images across symmetry planes the node lies on (a node on
     // such a plane sees the same particles again on the other side).
     const IVec<D> j = grid.multi_index(i);
@@ -467,6 +472,7 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
     begin[0] = 0;
     for (std::int64_t c = 0; c < n_cells_total; ++c) begin[c + 1] += begin[c];
     regions_.resize(static_cast<std::size_t>(begin[n_cells_total]));
+    corners_.resize(regions_.size());
     const double thickness = D == 2 ? options_.thickness : 1.0;
     const Vec<D> inv_h = h_.cwiseInverse();
 #pragma omp parallel for schedule(static)
@@ -481,9 +487,16 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
         q.cell = static_cast<std::int32_t>(c);
         q.volume = out[r].volume * thickness;
         q.centroid = out[r].centroid;
+        // The corners' nodes, S and G at the point, for the stages that read them (integrate,
+        // quadrature_gradients) as for the values below.
+        const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+        Corners& corner = corners_[begin[c] + r];
+        for (int k = 0; k < (1 << D); ++k) {
+          corner.node[k] = node[k];
+          corner_shape<D>(k, local, inv_h, corner.S[k], corner.G[k]);
+        }
         // Eq. 19-21: values at the point from the well-conditioned corners (alpha_i = 1); a
         // cell whose corners are all spurious falls back to all of them.
-        const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
         const bool fitted = options_.fitted_point_values;
         for (int pass = 0; pass < 2; ++pass) {
           double sum = 0.0;
@@ -492,9 +505,7 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
           q.stress.setZero();
           for (int k = 0; k < (1 << D); ++k) {
             if (pass == 0 && !alpha_[node[k]]) continue;
-            double S;
-            Vec<D> G;
-            corner_shape<D>(k, local, inv_h, S, G);
+            const double S = corner.S[k];
             sum += S;
             if (!fitted) {
               q.density += S * density_[node[k]];
@@ -537,7 +548,6 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
 template <int D>
 template <class Fn>
 void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const {
-  const Vec<D> inv_h = h_.cwiseInverse();
   const IVec<D> j = grid.multi_index(i);
   for (int k = 0; k < (1 << D); ++k) {  // node i is corner k of the cell j - bits(k)
     IVec<D> cell = j;
@@ -550,13 +560,7 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
     if (!inside) continue;
     std::int64_t c = 0;
     for (int a = D - 1; a >= 0; --a) c = c * n_cells_[a] + cell[a];
-    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
-    for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) {
-      double S;
-      Vec<D> G;
-      corner_shape<D>(k, (regions_[r].centroid - lo).cwiseProduct(inv_h), inv_h, S, G);
-      fn(r, regions_[r], S, G);
-    }
+    for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) fn(r, regions_[r], corners_[r].S[k], corners_[r].G[k]);
   }
 }
 
@@ -633,27 +637,11 @@ void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<
   // (the strain rate the internal force of Eq. 24 is the power conjugate of) ...
   const auto n_regions = static_cast<std::int64_t>(regions_.size());
   region_gradient_.resize(regions_.size());
-  const Vec<D> inv_h = h_.cwiseInverse();
 #pragma omp parallel for schedule(static)
   for (std::int64_t r = 0; r < n_regions; ++r) {
-    const Region<D>& q = regions_[r];
-    IVec<D> cell;
-    std::int64_t c = q.cell;
-    for (int a = 0; a < D; ++a) {
-      cell[a] = static_cast<int>(c % n_cells_[a]);
-      c /= n_cells_[a];
-    }
-    const Vec<D> lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
-    const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
+    const Corners& corner = corners_[r];
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> j = cell;
-      for (int a = 0; a < D; ++a) j[a] += (k >> a) & 1;
-      double S;
-      Vec<D> G;
-      corner_shape<D>(k, local, inv_h, S, G);
-      L += v_new[grid.node_index(j)] * G.transpose();
-    }
+    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
     region_gradient_[r] = L;
   }
   // ... and its S V-weighted mean over the integration points around each node.

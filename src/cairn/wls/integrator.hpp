@@ -177,12 +177,20 @@ class Integrator {
   std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
   std::vector<double> coef_;           ///< n_nodes x n_fields x n_basis: M^-1 l (Eq. 10), r in cells
   std::vector<std::uint8_t> alpha_;
+  std::vector<std::uint8_t> live_;     ///< a particle reached the node at its last fit
   std::vector<double> distance_;
   std::vector<Vec<D>> internal_force_;
   long long n_spurious_ = 0;
   // cells
   std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_
   std::vector<Region<D>> regions_;
+  /// Per region its cell's corner nodes (bit a of k: upper along a) and their S, G at the point.
+  struct Corners {
+    std::array<std::int32_t, (1 << D)> node;
+    std::array<double, (1 << D)> S;
+    std::array<Vec<D>, (1 << D)> G;
+  };
+  std::vector<Corners> corners_;
   std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
