@@ -10,7 +10,6 @@
 #include <cctype>
 #include <charconv>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <cmath>
 #include <fstream>
@@ -215,7 +214,7 @@ std::shared_ptr<const PointSet> read_point_h5_in_child(const std::string& path, 
   const ChildResult r = run_in_child(
       [&](std::string& out) {
         limit_address_space((1u << 30) + 200.0 * bytes);
-        auto put = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+        auto put = [&](const void* p, std::size_t n) { put_bytes(out, p, n); };
         try {
           const auto set = read_point_h5(path, dimension);
           out = "P";
@@ -237,16 +236,12 @@ std::shared_ptr<const PointSet> read_point_h5_in_child(const std::string& path, 
       },
       300);
   if (r.signal != 0 || r.timed_out || r.exit_code != 0 || r.output.empty())
-    throw std::invalid_argument(fmt::format("point file '{}': the HDF5 library failed on it ({}): a damaged file", path,
-                                            r.timed_out ? "it did not finish in 300 s"
-                                            : r.signal != 0 ? fmt::format("signal {}", r.signal)
-                                                            : fmt::format("exit code {}", r.exit_code)));
+    throw std::invalid_argument(
+        fmt::format("point file '{}': the HDF5 library failed on it ({}): a damaged file", path, child_ending(r, 300)));
   if (r.output[0] == 'E') throw std::invalid_argument(r.output.substr(1));
-  std::size_t at = 1;
+  AnswerReader answer(r.output, 1);
   auto take = [&](void* p, std::size_t n) {
-    if (at + n > r.output.size()) throw std::invalid_argument(fmt::format("point file '{}': a short answer", path));
-    if (n > 0) std::memcpy(p, r.output.data() + at, n);  // (an empty vector's data() may be null)
-    at += n;
+    if (!answer.take(p, n)) throw std::invalid_argument(fmt::format("point file '{}': a short answer", path));
   };
   auto set = std::make_shared<PointSet>();
   set->file = path;

@@ -27,7 +27,6 @@
 #include <boost/function_output_iterator.hpp>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -304,7 +303,7 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
         } catch (const std::exception& e) {
           error = e.what();
         }
-        auto put = [&](const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); };
+        auto put = [&](const void* p, std::size_t n) { put_bytes(out, p, n); };
         const std::uint64_t flags[3] = {ok ? 1u : 0u, points.size(), polygons.size()};
         put(flags, sizeof flags);
         for (const Point& p : points) {
@@ -321,16 +320,11 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
       },
       300);
   if (soup.signal != 0 || soup.timed_out || soup.exit_code != 0 || soup.output.size() < 24)
-    fail(path, fmt::format("CGAL's {} reader failed on it ({}): a damaged file", ext.substr(1),
-                           soup.timed_out ? "it did not finish in 300 s"
-                           : soup.signal != 0 ? fmt::format("signal {}", soup.signal)
-                                              : fmt::format("exit code {}", soup.exit_code)));
+    fail(path, fmt::format("CGAL's {} reader failed on it ({}): a damaged file", ext.substr(1), child_ending(soup, 300)));
   {
-    std::size_t at = 0;
+    AnswerReader answer(soup.output);
     auto take = [&](void* p, std::size_t n) {
-      if (at + n > soup.output.size()) fail(path, "CGAL's reader process sent a short answer");
-      if (n > 0) std::memcpy(p, soup.output.data() + at, n);  // (an empty vector's data() may be null)
-      at += n;
+      if (!answer.take(p, n)) fail(path, "CGAL's reader process sent a short answer");
     };
     std::uint64_t flags[3];
     take(flags, sizeof flags);
@@ -350,7 +344,7 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
       take(q.data(), n * sizeof(std::size_t));
       polygons.push_back(std::move(q));
     }
-    const std::string error = soup.output.substr(at);
+    const std::string error = answer.rest();
     if (!error.empty()) fail(path, fmt::format("CGAL's {} reader failed: {}", ext.substr(1), error));
   }
   if (!read)

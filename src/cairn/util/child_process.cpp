@@ -92,4 +92,17 @@ void limit_address_space(double bytes) {
 #endif
 }
 
+std::string child_ending(const ChildResult& result, int timeout_seconds) {
+  if (result.timed_out) return "it did not finish in " + std::to_string(timeout_seconds) + " s";
+  if (result.signal != 0) return "signal " + std::to_string(result.signal);
+  return "exit code " + std::to_string(result.exit_code);
+}
+
+bool AnswerReader::take(void* p, std::size_t n) {
+  if (n > answer_.size() || at_ > answer_.size() - n) return false;
+  if (n > 0) std::memcpy(p, answer_.data() + at_, n);  // (an empty string's data() is never read)
+  at_ += n;
+  return true;
+}
+
 }  // namespace cairn

@@ -4,6 +4,7 @@
 // (docs/robustness.md, "Files from outside").
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <string>
 
@@ -24,6 +25,27 @@ struct ChildResult {
 /// still catch a fault and exit with its own code: callers treat any exit code but the ones
 /// `work` returns as a crash. Throws std::runtime_error when no process can be started.
 ChildResult run_in_child(const std::function<int(std::string& out)>& work, int timeout_seconds);
+
+/// How a child that failed ended, for a message: "it did not finish in T s", "signal S" or
+/// "exit code E".
+std::string child_ending(const ChildResult& result, int timeout_seconds);
+
+/// A child's answer as packed binary values: the child appends them (put), the parent reads
+/// them back in the same order (take).
+inline void put_bytes(std::string& out, const void* p, std::size_t n) { out.append(static_cast<const char*>(p), n); }
+
+class AnswerReader {
+ public:
+  explicit AnswerReader(const std::string& answer, std::size_t at = 0) : answer_(answer), at_(at) {}
+  /// Copies the next n bytes to p; false (nothing copied) when fewer are left.
+  [[nodiscard]] bool take(void* p, std::size_t n);
+  /// The answer from the current position on.
+  [[nodiscard]] std::string rest() const { return answer_.substr(at_); }
+
+ private:
+  const std::string& answer_;
+  std::size_t at_;
+};
 
 /// In a child: at most `bytes` more address space than the process has now (RLIMIT_AS), so that
 /// an allocation sized by a damaged count fails (std::bad_alloc) instead of taking the machine's
