@@ -185,7 +185,6 @@ TEST(InputErrors, BadSetSyntax) {
 TEST(InputErrors, NodeHaloIsAcceptedWithContactAndAnUnknownHaloRefused) {
   // Contact runs under the node halo too (its point clouds travel with it; docs/parallel.md).
   const std::string contact = base + "[contact]\nmode = \"body\"\n";
-  EXPECT_FALSE(error_of(contact, {"parallel.halo=\"nodes\""}));
   EXPECT_EQ(load_config_string(contact, "case.toml", {"parallel.halo=\"nodes\""}).parallel.halo, "nodes");
   EXPECT_EQ(load_config_string(contact, "case.toml", {}).parallel.halo, "auto");
   EXPECT_EQ(load_config_string(base, "case.toml", {"parallel.halo=\"nodes\""}).parallel.halo, "nodes");
