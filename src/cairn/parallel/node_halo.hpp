@@ -91,7 +91,7 @@ class NodeHalo {
   struct Holder {
     std::size_t k, s;
   };
-  /// The other ranks holding window node `node`, as (neighbour k, row s of shared_nodes(k)), in
+  /// The other ranks holding window node `node`, as (neighbour k, row s of shared_with(k)), in
   /// increasing rank; empty for a node no other window holds.
   [[nodiscard]] std::span<const Holder> holders_of(std::int32_t node) const {
     if (union_of_.empty()) return {};
