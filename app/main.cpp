@@ -51,8 +51,11 @@ void print_summary(const cairn::RunSummary& s) {
   if (s.ranks > 1) {
     fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
                s.partitions, s.migrated, s.max_imbalance);
-    fmt::print("cairn: halo of {} (parallel.halo), {:.0f} bytes sent per rank and step\n", s.halo,
-               s.halo_bytes_per_step);
+    fmt::print("cairn: halo of {} (parallel.halo), {:.0f} bytes sent per rank and step{}\n", s.halo,
+               s.halo_bytes_per_step,
+               s.halo_cloud_bytes_per_step > 0.0
+                   ? fmt::format(" ({:.0f} of them particles of contact nodes)", s.halo_cloud_bytes_per_step)
+                   : std::string());
     if (s.halo == "nodes")
       fmt::print("cairn: node-halo sums took at most {:.3f} s on a rank ({:.1f}% of the run), {:.3f} s of it in "
                  "the exchange (the most an overlap with the scatter could hide)\n",

@@ -22,6 +22,12 @@ TIMEOUT = 4.0      # simulation.mpi_timeout of the stall case (s)
 BOUND = 60.0       # every faulty job must have ended this long after the fault (s)
 
 
+def job_tag(name):
+    """The CAIRN_FAULT_JOB of this script's job `name`: with the script's PID, so that the faults
+    of another worktree's run of this test at the same time never hit these ranks."""
+    return f"{name}-{os.getpid()}"
+
+
 def rank_pids(job, rank):
     """The PIDs of the cairn processes of `job` (an mpirun) with OMPI_COMM_WORLD_RANK = rank."""
     found = []
@@ -52,7 +58,7 @@ def start(args, name, extra_env=None, wrap=None, timeout=None):
         cmd += ["--set", f"simulation.mpi_timeout={timeout}"]
     if wrap:
         cmd = ["/bin/bash", "-c", wrap + ' exec "$@"', "wrap"] + cmd
-    env = dict(os.environ, CAIRN_FAULT_JOB=name, **(extra_env or {}))
+    env = dict(os.environ, CAIRN_FAULT_JOB=job_tag(name), **(extra_env or {}))
     job = subprocess.Popen([args.mpirun, "--oversubscribe", "--allow-run-as-root", "-np", "2"] + cmd,
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     return job, out
@@ -103,7 +109,7 @@ def case(args, name, expect, problems, fault, extra_env=None, wrap=None, timeout
         return
     since = time.monotonic()
     if fault:
-        pids = rank_pids(name, 1)
+        pids = rank_pids(job_tag(name), 1)
         if not pids:
             problems.append(f"{name}: rank 1's process not found")
         for pid in pids:
@@ -119,7 +125,7 @@ def case(args, name, expect, problems, fault, extra_env=None, wrap=None, timeout
         problems.append(f"{name}: exit code 0 after a fault")
     if missing:
         problems.append(f"{name}: the message lacks {missing}:\n{text[-1500:]}")
-    for p in rank_pids(name, 1):  # a stopped rank that the launcher left behind
+    for p in rank_pids(job_tag(name), 1):  # a stopped rank that the launcher left behind
         problems.append(f"{name}: rank 1 (pid {p}) is still there")
         os.kill(p, signal.SIGKILL)
     check_restart(args, out, problems, name)

@@ -98,7 +98,7 @@ def runs(group, out):
         yield ("checkpoint", ["run", str(DISKS)], 1)
         yield ("restart", ["restart", LATEST, "--set", "simulation.max_steps=30"], 1)
     elif group == "mpi":
-        yield ("contact_disks_2ranks", ["run", str(DISKS)], 2)  # (contact: the particle halo)
+        yield ("contact_disks_2ranks", ["run", str(DISKS)], 2)  # (contact under the node halo)
         cases = ROOT / "tests" / "mpi" / "cases"
         yield ("cpdi_wall_2ranks_nodes", ["run", str(cases / "cpdi_wall.toml")], 2)  # node halo, conduction
         yield ("fmpm_periodic_3ranks_nodes", ["run", str(cases / "fmpm_periodic.toml")], 3)

@@ -53,7 +53,7 @@ struct SimulationConfig {
 struct ParallelConfig {
   /// nodes: each rank scatters its own particles and node sums are exchanged across a halo one
   /// stencil wide; particles: ghost copies of the neighbours' particles, node sums in serial
-  /// order (bit-identical to a serial run); auto: nodes, or particles with [contact].
+  /// order (bit-identical to a serial run); auto: nodes.
   std::string halo = "auto";
 };
 

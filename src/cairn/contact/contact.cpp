@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <stdexcept>
@@ -148,6 +149,7 @@ Contact<D>::Contact(const Config& config, const Grid<D>& grid, const Particles<D
   need_clouds_ = cfg_.normal == "lr" || cfg_.normal == "linear" || cfg_.detection == "lr";
   need_gradient_ = cfg_.normal == "ag";
   need_position_ = cfg_.detection == "cp" || cfg_.detection == "df";
+  need_radius_ = cfg_.detection == "lr";
   if (cfg_.detection == "df") {
     const int ppc = config.bodies.empty() ? 2 : config.bodies.front().particles_per_cell[0];
     df_table(config.method, ppc, df_s_, df_d_);
@@ -232,10 +234,11 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
     inter_begin_.push_back(static_cast<std::int32_t>(inter_.size()));
   }
   node_steps_ += static_cast<long long>(nc);
-  if (nc == 0) return;
+  // A node-halo run's neighbours exchange below whether this rank has contact nodes or not.
+  const bool halo = halo_ != nullptr && halo_->n_neighbours() > 0;
+  if (nc == 0 && !halo) return;
 
   const std::size_t n_slots = static_cast<std::size_t>(nf) * static_cast<std::size_t>(n_nodes_);
-  const auto np = static_cast<std::int64_t>(particles.n());
   // Grid extrapolations for AG normals (Eq. 11: g = sum G V) and CP/DF positions (x = S+ X).
   if (need_gradient_ || need_position_) {
     if (need_gradient_) gradient_.assign(n_slots, Vec<D>::Zero());
@@ -254,37 +257,15 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
               (S * particles.mass[p]) * offset_from_node(*grid_, node, particles.position[p]);
       });
     });
-  }
-  // Point clouds: the particles whose stencil holds the contact node (seed 004 Sec. 3.1, Fig. 3A).
-  if (need_clouds_) {
-    cloud_begin_.assign(nc + 1, 0);
-    // Particles in increasing id (a distributed run's ghosts included; a serial run's particles
-    // kept in cell-block order), as in a serial run in creation order.
-    const bool own_order = cache.sorted_storage && cache.id_order.empty();
-    if (own_order) storage_in_id_order(particles, id_order_);
-    const std::vector<std::int32_t>& ids = own_order ? id_order_ : cache.id_order;
-    auto particle_at = [&](std::int64_t k) { return ids.empty() ? k : std::int64_t{ids[static_cast<std::size_t>(k)]}; };
-    for (std::int64_t p = 0; p < np; ++p)
-      for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
-        const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
-        if (c >= 0 && S > 0.0) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
-      });
-    for (std::size_t c = 0; c < nc; ++c) cloud_begin_[c + 1] += cloud_begin_[c];
-    cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
-    cloud_weight_.resize(cloud_.size());
-    std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
-    for (std::int64_t k = 0; k < np; ++k) {
-      const std::int64_t p = particle_at(k);
-      for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
-        const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
-        if (c >= 0 && S > 0.0) {
-          const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(c)]++);
-          cloud_[at] = static_cast<std::int32_t>(p);
-          cloud_weight_[at] = S;
-        }
-      });
+    // Node halo: the other ranks' particles add their parts at the shared nodes, as to the mass.
+    if (halo) {
+      if (need_gradient_ && need_position_) halo_->sum(nf, gradient_, position_);
+      else if (need_gradient_) halo_->sum(nf, gradient_);
+      else halo_->sum(nf, position_);
     }
   }
+  if (need_clouds_) build_clouds(particles, cache);
+  if (nc == 0) return;
   // Normals and separations, node by node.
   const ScopedSeconds fit_lap(fit_seconds_);
   const auto n_contact = static_cast<std::int64_t>(nc);
@@ -297,17 +278,185 @@ void Contact<D>::prepare(const Particles<D>& particles, const TransferCache<D>& 
 #pragma omp for schedule(dynamic, 16)
     for (std::int64_t c = 0; c < n_contact; ++c)
       for (std::int32_t k = inter_begin_[static_cast<std::size_t>(c)]; k < inter_begin_[static_cast<std::size_t>(c) + 1]; ++k)
-        geometry(static_cast<std::size_t>(c), particles, cache, mass, cloud_x, cloud_c, cloud_p, cloud_w,
+        geometry(static_cast<std::size_t>(c), particles, mass, cloud_x, cloud_c, cloud_p, cloud_w,
                  inter_[static_cast<std::size_t>(k)]);
   }
 }
 
 template <int D>
-void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
-                          const std::vector<double>& mass, std::vector<Vec3>& cloud_x,
-                          std::vector<signed char>& cloud_c, std::vector<std::int32_t>& cloud_p,
-                          std::vector<double>& cloud_w, Interaction& it) const {
-  (void)cache;
+void Contact<D>::build_clouds(const Particles<D>& particles, const TransferCache<D>& cache) {
+  // Point clouds: the particles whose stencil holds the contact node (seed 004 Sec. 3.1, Fig. 3A).
+  const std::size_t nc = nodes_.size();
+  const auto np = static_cast<std::int64_t>(particles.n());
+  // Node halo: the other ranks' particles at the contact nodes this window shares with theirs.
+  std::vector<std::int32_t> ghost_node, ghost_ref;
+  std::vector<double> ghost_weight;
+  ghosts_.clear();
+  const bool halo = halo_ != nullptr && halo_->n_neighbours() > 0;
+  if (halo) exchange_cloud_particles(particles, cache, ghost_node, ghost_ref, ghost_weight);
+  cloud_begin_.assign(nc + 1, 0);
+  // Particles in increasing id (a distributed run's ghosts included; a serial run's particles
+  // kept in cell-block order), as in a serial run in creation order. (Under a node halo each
+  // cloud is sorted by id below, with the other ranks' particles.)
+  const bool own_order = !halo && cache.sorted_storage && cache.id_order.empty();
+  if (own_order) storage_in_id_order(particles, id_order_);
+  const std::vector<std::int32_t>& ids = own_order ? id_order_ : cache.id_order;
+  auto particle_at = [&](std::int64_t k) { return ids.empty() ? k : std::int64_t{ids[static_cast<std::size_t>(k)]}; };
+  for (std::int64_t p = 0; p < np; ++p)
+    for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
+      const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
+      if (c >= 0 && S > 0.0) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
+    });
+  for (std::int32_t c : ghost_node) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
+  for (std::size_t c = 0; c < nc; ++c) cloud_begin_[c + 1] += cloud_begin_[c];
+  cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
+  cloud_weight_.resize(cloud_.size());
+  std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
+  for (std::int64_t k = 0; k < np; ++k) {
+    const std::int64_t p = particle_at(k);
+    for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
+      const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
+      if (c >= 0 && S > 0.0) {
+        const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(c)]++);
+        cloud_[at] = static_cast<std::int32_t>(p);
+        cloud_weight_[at] = S;
+      }
+    });
+  }
+  if (!halo) return;
+  for (std::size_t e = 0; e < ghost_node.size(); ++e) {
+    const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(ghost_node[e])]++);
+    cloud_[at] = ghost_ref[e];
+    cloud_weight_[at] = ghost_weight[e];
+  }
+  // Every cloud in increasing id: the order of the serial run, and the same on every rank that
+  // holds the node, so that all copies of a shared node fit the same points in the same order
+  // and get the same bits.
+  std::vector<std::pair<std::int64_t, std::int32_t>> order;
+  std::vector<std::int32_t> refs;
+  std::vector<double> weights;
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto b = static_cast<std::size_t>(cloud_begin_[c]), e = static_cast<std::size_t>(cloud_begin_[c + 1]);
+    order.clear();
+    for (std::size_t k = b; k < e; ++k)
+      order.emplace_back(cloud_id(particles, cloud_[k]), static_cast<std::int32_t>(k - b));
+    std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    refs.assign(cloud_.begin() + static_cast<std::ptrdiff_t>(b), cloud_.begin() + static_cast<std::ptrdiff_t>(e));
+    weights.assign(cloud_weight_.begin() + static_cast<std::ptrdiff_t>(b),
+                   cloud_weight_.begin() + static_cast<std::ptrdiff_t>(e));
+    for (std::size_t k = b; k < e; ++k) {
+      const auto from = static_cast<std::size_t>(order[k - b].second);
+      cloud_[k] = refs[from];
+      cloud_weight_[k] = weights[from];
+    }
+  }
+}
+
+namespace {
+
+template <class T>
+void put(std::vector<char>& out, const T& value) {
+  const auto at = out.size();
+  out.resize(at + sizeof(T));
+  std::memcpy(out.data() + at, static_cast<const void*>(&value), sizeof(T));
+}
+
+template <class T>
+T take(const char*& at, const char* end) {
+  if (static_cast<std::size_t>(end - at) < sizeof(T))
+    throw std::runtime_error("contact: a neighbour's message of cloud particles ends early");
+  T value;
+  std::memcpy(static_cast<void*>(&value), at, sizeof(T));
+  at += sizeof(T);
+  return value;
+}
+
+}  // namespace
+
+template <int D>
+void Contact<D>::exchange_cloud_particles(const Particles<D>& particles, const TransferCache<D>& cache,
+                                          std::vector<std::int32_t>& entry_node, std::vector<std::int32_t>& entry_ref,
+                                          std::vector<double>& entry_weight) {
+  // The point cloud of a node is every particle whose stencil holds it. Such a particle of
+  // another rank reaches this window only at a node both windows hold (its stencil lies in its
+  // own rank's window), and the ranks agree on which shared nodes are contact nodes (their node
+  // masses are the same bits after the halo sum). So each rank sends each neighbour, once per
+  // particle, what the fits read of its particles that reach their shared contact nodes -- id,
+  // field, position (and F and the initial size for LR separations) -- with the rows of those
+  // nodes in the shared list and the weights S_ip: a band one stencil wide around the contact
+  // nodes on the rank boundary, not the whole ghost band of the particle halo.
+  const std::size_t nk = halo_->n_neighbours();
+  cloud_send_.resize(nk);
+  for (auto& b : cloud_send_) b.clear();
+  struct Entry {
+    std::size_t k;
+    std::int32_t row;
+    double S;
+  };
+  std::vector<Entry> entries;
+  for (std::size_t p = 0; p < particles.n(); ++p) {
+    entries.clear();
+    for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>&) {
+      if (!(S > 0.0) || contact_of_[static_cast<std::size_t>(node)] < 0) return;
+      for (const auto& h : halo_->holders_of(node)) entries.push_back({h.k, static_cast<std::int32_t>(h.s), S});
+    });
+    if (entries.empty()) continue;
+    std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.k < b.k; });
+    for (std::size_t i = 0; i < entries.size();) {
+      std::size_t j = i;
+      while (j < entries.size() && entries[j].k == entries[i].k) ++j;
+      std::vector<char>& out = cloud_send_[entries[i].k];
+      put(out, particles.id[p]);
+      put(out, field_of(particles, p));
+      put(out, static_cast<std::int32_t>(j - i));
+      put(out, particles.position[p]);
+      if (need_radius_) {
+        put(out, particles.deformation_gradient[p]);
+        put(out, particles.size0[p]);
+      }
+      for (; i < j; ++i) {
+        put(out, entries[i].row);
+        put(out, entries[i].S);
+      }
+    }
+  }
+  const Comm::Buffers recv = halo_->exchange(cloud_send_);
+  for (std::size_t k = 0; k < nk; ++k) {
+    const std::vector<std::int32_t>& shared = halo_->shared_with(k);
+    const char* at = recv[k].data();
+    const char* const end = at + recv[k].size();
+    while (at < end) {
+      const auto g = static_cast<std::int32_t>(ghosts_.id.size());
+      ghosts_.id.push_back(take<std::int64_t>(at, end));
+      ghosts_.field.push_back(take<std::int32_t>(at, end));
+      const auto n = take<std::int32_t>(at, end);
+      ghosts_.position.push_back(take<Vec<D>>(at, end));
+      if (need_radius_) {
+        ghosts_.deformation_gradient.push_back(take<Mat3>(at, end));
+        ghosts_.size0.push_back(take<Vec<D>>(at, end));
+      }
+      for (std::int32_t e = 0; e < n; ++e) {
+        const auto row = take<std::int32_t>(at, end);
+        const double S = take<double>(at, end);
+        const std::int32_t c = row >= 0 && static_cast<std::size_t>(row) < shared.size()
+                                   ? contact_of_[static_cast<std::size_t>(shared[static_cast<std::size_t>(row)])]
+                                   : -1;
+        if (c < 0)
+          throw std::runtime_error(fmt::format("contact: rank {} sent a cloud particle for shared node row {}, which "
+                                               "is no contact node here (the node halo is out of step)",
+                                               halo_->neighbour(k), row));
+        entry_node.push_back(c);
+        entry_ref.push_back(-1 - g);
+        entry_weight.push_back(S);
+      }
+    }
+  }
+}
+
+template <int D>
+void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const std::vector<double>& mass,
+                          std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c,
+                          std::vector<std::int32_t>& cloud_p, std::vector<double>& cloud_w, Interaction& it) const {
   const std::int32_t node = nodes_[c];
   const int nf = n_fields();
   auto in_beta = [&](std::int32_t f) { return it.b < 0 ? f != it.a : f == it.b; };
@@ -322,12 +471,12 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     cloud_w.clear();
     for (std::int32_t k = cloud_begin_[c]; k < cloud_begin_[c + 1]; ++k) {
       const std::int32_t p = cloud_[static_cast<std::size_t>(k)];
-      const std::int32_t f = field_of(particles, static_cast<std::size_t>(p));
+      const std::int32_t f = cloud_field(particles, p);
       signed char cls = 0;
       if (f == it.a) cls = -1;
       else if (in_beta(f)) cls = 1;
       else continue;
-      cloud_x.push_back(to3<D>(offset_from_node(*grid_, node, particles.position[p])));
+      cloud_x.push_back(to3<D>(offset_from_node(*grid_, node, cloud_position(particles, p))));
       cloud_c.push_back(cls);
       cloud_p.push_back(p);
       cloud_w.push_back(cloud_weight_[static_cast<std::size_t>(k)]);
@@ -387,11 +536,14 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const Tr
     // lr_separation = "column": only the particles within half a cell of the node's line along n.
     const double column = cfg_.lr_separation == "column" ? 0.5 * cell_width(n) : 0.0;
     for (std::size_t k = 0; k < cloud_x.size(); ++k) {
-      const auto p = static_cast<std::size_t>(cloud_p[k]);
+      const std::int32_t r = cloud_p[k];  // (p >= 0: this rank's particle, else ghost -1 - r)
       if (column > 0.0 && (cloud_x[k] - cloud_x[k].dot(n) * n).norm() > column) continue;
+      const auto g = static_cast<std::size_t>(-1 - r);
+      const Vec<D>& size0 = r >= 0 ? particles.size0[static_cast<std::size_t>(r)] : ghosts_.size0[g];
+      const Mat3& F = r >= 0 ? particles.deformation_gradient[static_cast<std::size_t>(r)] : ghosts_.deformation_gradient[g];
       Vec3 R0 = Vec3::Ones();
-      for (int a = 0; a < D; ++a) R0[a] = 0.5 * particles.size0[p][a];
-      const double R = contact::deformed_radius(particles.deformation_gradient[p], R0, n, D);
+      for (int a = 0; a < D; ++a) R0[a] = 0.5 * size0[a];
+      const double R = contact::deformed_radius(F, R0, n, D);
       const double xn = cloud_x[k].dot(n);
       if (cloud_c[k] < 0) max_a = std::max(max_a, xn + R);
       else min_b = std::min(min_b, xn - R);

@@ -22,6 +22,7 @@
 #include "cairn/config/config.hpp"
 #include "cairn/materials/material.hpp"
 #include "cairn/parallel/exact_sum.hpp"
+#include "cairn/parallel/node_halo.hpp"
 #include "cairn/particles/particles.hpp"
 #include "cairn/shapes/shape_family.hpp"
 #include "cairn/transfer/cache.hpp"
@@ -56,6 +57,12 @@ class Contact {
 
   /// The grid passed to the constructor now stores another window (a distributed run).
   void grid_changed();
+  /// A node-halo run (parallel.halo = "nodes"): each rank holds its own particles only, and the
+  /// grid is a window whose shared nodes `halo` sums. prepare() then sums the contact node arrays
+  /// it scatters (AG gradients, CP/DF positions) through it and brings every point cloud the
+  /// particles of the other ranks that reach the node (docs/parallel.md, "Contact under the node
+  /// halo"). Null: every particle of a cloud is on this rank (serial, or the particle halo).
+  void use_halo(NodeHalo<D>* halo) { halo_ = halo; }
   /// Sum the updated pass's forces and counts over the ranks (collective; call once per step
   /// after the updated pass, also in a serial run, before reading the three values below).
   void reduce(const Comm& comm);
@@ -114,9 +121,28 @@ class Contact {
     double separation = -1.0;     ///< < 0: touching
     double area = 0.0;
   };
-  void geometry(std::size_t c, const Particles<D>& particles, const TransferCache<D>& cache,
-                const std::vector<double>& mass, std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c,
-                std::vector<std::int32_t>& cloud_p, std::vector<double>& cloud_w, Interaction& it) const;
+  void geometry(std::size_t c, const Particles<D>& particles, const std::vector<double>& mass,
+                std::vector<Vec3>& cloud_x, std::vector<signed char>& cloud_c, std::vector<std::int32_t>& cloud_p,
+                std::vector<double>& cloud_w, Interaction& it) const;
+  /// The point clouds (cloud_begin_, cloud_, cloud_weight_) of the contact nodes: this rank's
+  /// particles whose stencil holds the node, and under a node halo the other ranks' (ghosts_).
+  void build_clouds(const Particles<D>& particles, const TransferCache<D>& cache);
+  /// Node halo: send each neighbour the particles whose stencils reach the contact nodes it
+  /// shares with this window, receive its own into ghosts_; per received stencil entry, its
+  /// contact node, cloud reference and weight (collective with the neighbours).
+  void exchange_cloud_particles(const Particles<D>& particles, const TransferCache<D>& cache,
+                                std::vector<std::int32_t>& entry_node, std::vector<std::int32_t>& entry_ref,
+                                std::vector<double>& entry_weight);
+  /// A cloud entry's particle: p >= 0 one of this rank's, -1 - g ghost g (node halo).
+  [[nodiscard]] const Vec<D>& cloud_position(const Particles<D>& particles, std::int32_t ref) const {
+    return ref >= 0 ? particles.position[static_cast<std::size_t>(ref)] : ghosts_.position[static_cast<std::size_t>(-1 - ref)];
+  }
+  [[nodiscard]] std::int32_t cloud_field(const Particles<D>& particles, std::int32_t ref) const {
+    return ref >= 0 ? field_of(particles, static_cast<std::size_t>(ref)) : ghosts_.field[static_cast<std::size_t>(-1 - ref)];
+  }
+  [[nodiscard]] std::int64_t cloud_id(const Particles<D>& particles, std::int32_t ref) const {
+    return ref >= 0 ? particles.id[static_cast<std::size_t>(ref)] : ghosts_.id[static_cast<std::size_t>(-1 - ref)];
+  }
   /// h_n = |(n_a h_a)|: the cell's width along unit n (the cell size for square cells).
   [[nodiscard]] double cell_width(const Vec3& n) const;
   [[nodiscard]] double contact_area(const Vec3& n) const;
@@ -150,6 +176,26 @@ class Contact {
   std::vector<Interaction> inter_;
   std::vector<Vec<D>> gradient_;  ///< AG: sum_p G_ip V_p per slot (Eq. 11)
   std::vector<Vec<D>> position_;  ///< CP/DF: S+ X per slot (Eq. 11), relative to the node
+  /// Node halo: the other ranks' particles in this rank's point clouds, what the fits read of
+  /// them (F and the initial size only for LR separations).
+  struct Ghosts {
+    std::vector<std::int64_t> id;
+    std::vector<std::int32_t> field;
+    std::vector<Vec<D>> position;
+    std::vector<Mat3> deformation_gradient;
+    std::vector<Vec<D>> size0;
+    void clear() {
+      id.clear();
+      field.clear();
+      position.clear();
+      deformation_gradient.clear();
+      size0.clear();
+    }
+  };
+  NodeHalo<D>* halo_ = nullptr;
+  Ghosts ghosts_;
+  bool need_radius_ = false;  ///< LR separations read each cloud particle's F and initial size
+  Comm::Buffers cloud_send_;  ///< node halo: per neighbour, kept between steps
 
   // DF table: extrapolated centre offset s -> edge distance d, both in cells, increasing
   std::vector<double> df_s_, df_d_;

@@ -278,7 +278,7 @@ Config Loader::read_all(const toml::table& root) {
   read_velocity_conditions(root, cfg);
   read_walls(root, cfg);
   read_contact(root, cfg);
-  read_parallel(root, cfg);  // (after [contact], which decides what halo = "nodes" may mean)
+  read_parallel(root, cfg);
   read_output(root, cfg);
   cfg.resolved_toml = config_to_toml(cfg);
   cfg.warnings = std::move(warnings_);

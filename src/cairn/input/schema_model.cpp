@@ -99,8 +99,9 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "wide; results equal a serial run's to round-off, and are the same bits run to run "
                  "on the same ranks); particles = each rank also holds ghost copies of its "
                  "neighbours' particles and sums nodes in serial order (bit-identical to a serial "
-                 "run, more work and memory per rank); auto = nodes, or particles with [contact] "
-                 "(its normals need the particles around a node). Unused on one rank.")
+                 "run, more work and memory per rank); auto = nodes. With [contact] the node halo "
+                 "also sends each neighbour the particles whose stencils reach the contact nodes "
+                 "they share (for the point clouds of the normals). Unused on one rank.")
                 .by_default("\"auto\"")
                 .choices([] { return std::vector<std::string>{"auto", "nodes", "particles"}; }));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,

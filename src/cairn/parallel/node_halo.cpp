@@ -30,6 +30,7 @@ void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition,
   neighbours_.clear();
   shared_.clear();
   union_.clear();
+  union_of_.clear();
   holder_start_.assign(1, 0);
   holders_.clear();
   lower_.clear();
@@ -68,6 +69,7 @@ void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition,
       place[static_cast<std::size_t>(i)] = static_cast<std::int32_t>(union_.size());
       union_.push_back(i);
     }
+  union_of_ = place;  // (-1: a node no other window holds)
   // Per shared node, where each other holder's partial arrives, in increasing rank (CSR).
   std::vector<std::vector<Holder>> of(union_.size());
   for (std::size_t k = 0; k < shared_.size(); ++k)

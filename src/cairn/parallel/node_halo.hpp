@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
@@ -86,8 +87,41 @@ class NodeHalo {
     seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   }
 
-  /// Bytes this rank has sent in sums so far.
-  [[nodiscard]] std::int64_t bytes_sent() const { return bytes_sent_; }
+  /// Where a neighbour's partial of a shared node arrives: neighbour k, row s of its message.
+  struct Holder {
+    std::size_t k, s;
+  };
+  /// The other ranks holding window node `node`, as (neighbour k, row s of shared_with(k)), in
+  /// increasing rank; empty for a node no other window holds.
+  [[nodiscard]] std::span<const Holder> holders_of(std::int32_t node) const {
+    if (union_of_.empty()) return {};
+    const std::int32_t u = union_of_[static_cast<std::size_t>(node)];
+    if (u < 0) return {};
+    return {holders_.data() + holder_start_[static_cast<std::size_t>(u)],
+            holder_start_[static_cast<std::size_t>(u) + 1] - holder_start_[static_cast<std::size_t>(u)]};
+  }
+  /// Neighbour k's rank (increasing in k) and the window nodes this window shares with it, in the
+  /// order both sides list them.
+  [[nodiscard]] std::size_t n_neighbours() const { return neighbours_.size(); }
+  [[nodiscard]] int neighbour(std::size_t k) const { return neighbours_[k]; }
+  [[nodiscard]] const std::vector<std::int32_t>& shared_with(std::size_t k) const { return shared_[k]; }
+  /// Messages of sizes the receivers do not know (send[k] to neighbour k; Comm::exchange, a size
+  /// round first): e.g. the particles of contact nodes (contact/contact.cpp). Counted in
+  /// bytes_sent() and seconds(), and apart in message_bytes_sent().
+  [[nodiscard]] Comm::Buffers exchange(const Comm::Buffers& send) {
+    const auto started = std::chrono::steady_clock::now();
+    for (const auto& b : send) message_bytes_ += static_cast<std::int64_t>(b.size());
+    Comm::Buffers recv = comm_.exchange(neighbours_, send);
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    wait_seconds_ += took;
+    seconds_ += took;
+    return recv;
+  }
+
+  /// Bytes this rank has sent in sums and exchange() so far.
+  [[nodiscard]] std::int64_t bytes_sent() const { return bytes_sent_ + message_bytes_; }
+  /// Of them, the bytes of exchange() messages.
+  [[nodiscard]] std::int64_t message_bytes_sent() const { return message_bytes_; }
   /// Seconds this rank has spent in sums so far (packing, exchange, totals).
   [[nodiscard]] double seconds() const { return seconds_; }
   /// Of those, the seconds in the exchange itself (waiting for the neighbours' messages): the
@@ -122,10 +156,6 @@ class NodeHalo {
       }
     }
   }
-  /// Where a neighbour's partial of a shared node arrives: neighbour k, row s of its message.
-  struct Holder {
-    std::size_t k, s;
-  };
   Comm comm_ = Comm::serial();
   int rank_ = 0;
   int margin_ = -1;
@@ -134,11 +164,12 @@ class NodeHalo {
   std::vector<int> neighbours_;                     ///< increasing rank
   std::vector<std::vector<std::int32_t>> shared_;   ///< per neighbour: window nodes, canonical order
   std::vector<std::int32_t> union_;                 ///< every shared node of this window, once
+  std::vector<std::int32_t> union_of_;              ///< per window node: index into union_ or -1
   std::vector<std::size_t> holder_start_;           ///< per union_ node: its holders_ (CSR)
   std::vector<Holder> holders_;                     ///< the other holders of each, increasing rank
   std::vector<std::size_t> lower_;                  ///< per union_ node: holders below this rank
   Comm::Buffers send_, recv_;                       ///< per neighbour, kept between sums
-  std::int64_t bytes_sent_ = 0;
+  std::int64_t bytes_sent_ = 0, message_bytes_ = 0;
   double seconds_ = 0.0, wait_seconds_ = 0.0;
 };
 

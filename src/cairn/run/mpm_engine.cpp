@@ -277,6 +277,7 @@ class MpmEngine final : public Engine {
     start_ = last_autosave_ = Clock::now();
     first_step_ = sim_.step_count();
     halo_bytes_start_ = sim_.halo_bytes();
+    halo_cloud_bytes_start_ = sim_.halo_cloud_bytes();
     halo_seconds_start_ = {sim_.halo_seconds(), sim_.halo_wait_seconds()};
     if (!restarted_) {
       clear_earlier_outputs();
@@ -339,9 +340,13 @@ class MpmEngine final : public Engine {
     summary.partitions = sim_.distribution().partitions();
     summary.halo = sim_.halo();
     {
-      std::int64_t bytes = comm_.sum(sim_.halo_bytes() - halo_bytes_start_);
-      summary.halo_bytes_per_step =
-          summary.steps > 0 ? static_cast<double>(bytes) / comm_.size() / static_cast<double>(summary.steps) : 0.0;
+      std::int64_t bytes[2] = {sim_.halo_bytes() - halo_bytes_start_, sim_.halo_cloud_bytes() - halo_cloud_bytes_start_};
+      comm_.sum(bytes, 2);
+      auto per_step = [&](std::int64_t b) {
+        return summary.steps > 0 ? static_cast<double>(b) / comm_.size() / static_cast<double>(summary.steps) : 0.0;
+      };
+      summary.halo_bytes_per_step = per_step(bytes[0]);
+      summary.halo_cloud_bytes_per_step = per_step(bytes[1]);
       summary.halo_seconds = comm_.max(sim_.halo_seconds() - halo_seconds_start_[0]);
       summary.halo_wait_seconds = comm_.max(sim_.halo_wait_seconds() - halo_seconds_start_[1]);
     }
@@ -569,6 +574,7 @@ class MpmEngine final : public Engine {
   Clock::time_point start_{}, last_autosave_{};
   long long first_step_ = 0;
   std::int64_t halo_bytes_start_ = 0;  ///< halo bytes sent before this run's first step
+  std::int64_t halo_cloud_bytes_start_ = 0;  ///< of them, particles of contact nodes
   std::array<double, 2> halo_seconds_start_{};  ///< seconds in node-halo sums and exchanges before it
   bool started_ = false;
   std::unique_ptr<ThreadTuner> tuner_;

@@ -28,6 +28,7 @@ struct RunSummary {
   double halo_seconds = 0.0;         ///< node halo: the most seconds a rank spent in halo sums
   double halo_wait_seconds = 0.0;    ///< of them, the most a rank spent in their exchanges
   double halo_bytes_per_step = 0.0;  ///< several ranks: mean bytes a rank sent per step in halo exchanges
+  double halo_cloud_bytes_per_step = 0.0;  ///< of them, particles of contact nodes (node halo with contact)
   int partitions = 0;           ///< domain partitions (start-up and repartitions), several ranks
   long long migrated = 0;       ///< particles that moved between ranks
   double max_imbalance = 1.0;   ///< largest particle imbalance seen at a step's start

@@ -113,6 +113,8 @@ class Simulation {
   [[nodiscard]] std::int64_t halo_bytes() const {
     return node_halo_ ? halo_.bytes_sent() : distribution_.ghost_bytes_sent();
   }
+  /// Of them, the bytes of the particles of contact nodes (a node halo with contact).
+  [[nodiscard]] std::int64_t halo_cloud_bytes() const { return node_halo_ ? halo_.message_bytes_sent() : 0; }
   /// Seconds this rank has spent in node-halo sums, and in their exchanges (0 for the particle
   /// halo).
   [[nodiscard]] double halo_seconds() const { return node_halo_ ? halo_.seconds() : 0.0; }
