@@ -66,6 +66,7 @@ void Loader::read_parallel(const toml::table& root, Config& cfg) {
   TableReader r(*this, section(root, "parallel"), {"parallel"}, copy_section("parallel"), "[parallel]");
   r.reject_unknown_keys();
   cfg.parallel.halo = r.string("halo");
+  cfg.parallel.balance = r.string("balance");
   if (cfg.parallel.halo == "nodes" && cfg.contact.enabled())
     r.fail("halo", r.given("halo"), "\"particles\" or \"auto\" with [contact] (contact normals need the particles "
            "around each node; docs/parallel.md)", toml_string(cfg.parallel.halo));

@@ -103,6 +103,14 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "(its normals need the particles around a node). Unused on one rank.")
                 .by_default("\"auto\"")
                 .choices([] { return std::vector<std::string>{"auto", "nodes", "particles"}; }));
+  k.push_back(Key("parallel", "balance", T::string,
+                 "Runs on several MPI ranks (docs/parallel.md, \"Load balance\"): what the domain "
+                 "bisection shares out equally among the ranks. count = particles; cost = the "
+                 "particles' cost per step, measured per material model (bench/material_cost.py) "
+                 "or set by the material's balance_cost. The history column `imbalance` and "
+                 "simulation.rebalance_threshold then measure the same. Unused on one rank.")
+                .by_default("\"count\"")
+                .choices([] { return std::vector<std::string>{"count", "cost"}; }));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,
                  "Refuse a run whose end_time / first time step exceeds this (a run that would "
                  "never end), naming the material that sets the step; 0 = no check. Not checked "
@@ -213,6 +221,13 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "Heat capacity per unit mass c_p (conduction; heating by plastic and viscous work).")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("material", "balance_cost", T::real,
+                 "With [parallel] balance = \"cost\" on several MPI ranks: the cost of a step of "
+                 "one of its particles relative to one of a corotational linear_elastic material; "
+                 "0 = the figure measured for its model (docs/parallel.md, \"Load balance\").")
+                .by_default("0.0")
+                .min(0.0)
+                .max(1000.0));
 
   // [[body]]
   k.push_back(Key("body", "name", T::string,
