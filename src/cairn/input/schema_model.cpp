@@ -74,9 +74,10 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                 .by_default("true"));
   k.push_back(Key("simulation", "rebalance_threshold", T::real,
                  "Runs on several MPI ranks (docs/parallel.md): repartition the domain when the "
-                 "largest particle count of a rank exceeds the mean count by more than this "
-                 "fraction (history column `imbalance` = largest / mean); checked every step. A "
-                 "large value (e.g. 1e9) keeps the start-up partition. Unused on one rank.")
+                 "largest particle count of a rank (its cost with [parallel] balance = \"cost\") "
+                 "exceeds the mean by more than this fraction (history column `imbalance` = "
+                 "largest / mean); checked every step. A repartition moves only the cuts out of "
+                 "balance. A large value (e.g. 1e9) keeps the start-up partition. Unused on one rank.")
                 .by_default("0.25")
                 .min(0.0));
   k.push_back(Key("simulation", "memory_limit", T::real,
