@@ -67,7 +67,12 @@ std::int64_t Distribution<D>::rebalance(Particles<D>& particles, double threshol
   census(particles, cells, weights);
   int depth = 0;
   while ((1 << depth) < comm_.size()) ++depth;
-  decomposition_ = decomposition_.rebalanced(comm_, cells, weights, threshold / (2.0 * depth));
+  Decomposition<D> next = decomposition_.rebalanced(comm_, cells, weights, threshold / (2.0 * depth));
+  bool same = true;
+  for (int r = 0; r < next.n_boxes() && same; ++r)
+    same = next.box(r).lo == decomposition_.box(r).lo && next.box(r).hi == decomposition_.box(r).hi;
+  if (same) return 0;  // every cut kept: the boxes, neighbours and halos stay as they are
+  decomposition_ = std::move(next);
   ++partitions_;
   band_ = -1;
   const std::int64_t moved = comm_.sum(static_cast<std::int64_t>(migrate(particles)));

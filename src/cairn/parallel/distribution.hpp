@@ -42,7 +42,7 @@ class Distribution {
   /// Whether there is more than one rank (otherwise every method below is a no-op).
   [[nodiscard]] bool active() const { return comm_.parallel(); }
   [[nodiscard]] const Decomposition<D>& decomposition() const { return decomposition_; }
-  /// Number of partitions so far (the start-up one, then each repartition).
+  /// Number of partitions so far (the start-up one, then each repartition that changed a box).
   [[nodiscard]] int partitions() const { return partitions_; }
   /// Particles this rank has received from other ranks so far (migration and partitions).
   [[nodiscard]] std::int64_t received() const { return received_; }
@@ -64,7 +64,8 @@ class Distribution {
   /// particles that changed box migrate (collective). Returns the particles that changed rank,
   /// over all ranks.
   std::int64_t rebalance(Particles<D>& particles, double threshold);
-  /// Repartitions so far, the particles they moved (over all ranks) and the most one moved.
+  /// Repartitions so far that changed a box, the particles they moved (over all ranks) and the
+  /// most one moved.
   [[nodiscard]] int repartitions() const { return repartitions_; }
   [[nodiscard]] std::int64_t repartition_moved() const { return repartition_moved_; }
   [[nodiscard]] std::int64_t repartition_most_moved() const { return repartition_most_moved_; }
