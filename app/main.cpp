@@ -49,8 +49,12 @@ void print_summary(const cairn::RunSummary& s) {
     fmt::print("cairn: particles sorted into cell-block order {} time{} (simulation.sort_particles)\n",
                s.particle_sorts, s.particle_sorts == 1 ? "" : "s");
   if (s.ranks > 1) {
-    fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f}\n",
-               s.partitions, s.migrated, s.max_imbalance);
+    fmt::print("cairn: {} domain partitions, {} particles moved between ranks, largest imbalance {:.3f} (of {}, "
+               "parallel.balance)\n",
+               s.partitions, s.migrated, s.max_imbalance, s.balance == "cost" ? "cost" : "particle counts");
+    if (s.repartitions > 0)
+      fmt::print("cairn: {} repartition{} moved {} particles, at most {} in one\n", s.repartitions,
+                 s.repartitions == 1 ? "" : "s", s.repartition_moved, s.repartition_most_moved);
     fmt::print("cairn: halo of {} (parallel.halo), {:.0f} bytes sent per rank and step{}\n", s.halo,
                s.halo_bytes_per_step,
                s.halo_cloud_bytes_per_step > 0.0

@@ -533,12 +533,14 @@ TEST(Input, DefaultsAreFilled) {
   EXPECT_EQ(c.method.order, 1);
   EXPECT_EQ(c.method.stress_update, "usl");
   EXPECT_EQ(c.parallel.halo, "auto");
+  EXPECT_EQ(c.parallel.balance, "count");
   EXPECT_EQ(c.method.plugin.real("smoothing_length"), 0.0);
   EXPECT_TRUE(c.constants.empty());
   ASSERT_EQ(c.materials.size(), 1u);
   EXPECT_EQ(c.materials[0].numbers,
             (std::map<std::string, double>{{"density", 1500.0}, {"youngs_modulus", 1.0e6}, {"poissons_ratio", 0.3},
-                                          {"conductivity", 0.0}, {"heat_capacity", 0.0}, {"damping_time", 0.0}}));
+                                          {"conductivity", 0.0}, {"heat_capacity", 0.0}, {"balance_cost", 0.0},
+                                          {"damping_time", 0.0}}));
   EXPECT_EQ(c.materials[0].where.str(), "examples/case.toml:16");
   ASSERT_EQ(c.bodies.size(), 1u);
   const BodyConfig& b = c.bodies[0];

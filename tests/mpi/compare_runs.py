@@ -13,6 +13,8 @@ Checks (docs/parallel.md, "Determinism"):
     domain again (its summary line says how often);
   - --restart N:M: the checkpoint the N-rank run wrote first, continued on M ranks, ends with
     the serial run's history and final particles;
+  - --balance cost: the MPI runs balanced cost, not particle counts (parallel.balance; the
+    summary's imbalance line says which) and their repartitions reported the particles they moved;
   - --compression Z: every run writes gzip level Z (output.compression), and the MPI runs' last
     snapshot and first checkpoint hold compressed datasets (written collectively).
 Exit 0 only when every check holds; the last line says RESULT: ...
@@ -189,6 +191,8 @@ def main():
     ap.add_argument("--tolerance", type=float, default=1e-12,
                     help="--halo nodes: largest difference over the largest magnitude of a column/dataset")
     ap.add_argument("--compression", type=int, default=0, help="output.compression of every run (0: plain)")
+    ap.add_argument("--balance", choices=["count", "cost"], default="",
+                    help="require the MPI runs to have balanced this (the case's parallel.balance)")
     args = ap.parse_args()
     common = ["--set", f"output.compression={args.compression}"] if args.compression else []  # every run
     halo = ["--set", f'parallel.halo="{args.halo}"'] + common
@@ -210,6 +214,12 @@ def main():
             problems.append(f"np {n}: no particle moved between ranks")
         if args.repartition and partitions < 2:
             problems.append(f"np {n}: the domain was never repartitioned")
+        if args.balance:
+            what = "cost" if args.balance == "cost" else "particle counts"
+            if f"(of {what}, parallel.balance)" not in summary:
+                problems.append(f"np {n}: the summary does not say the imbalance is of {what}")
+            if partitions > 1 and not re.search(r"\d+ repartitions? moved \d+ particles, at most \d+ in one", summary):
+                problems.append(f"np {n}: {partitions - 1} repartitions but no line of the particles they moved")
         problems += compare_history(serial, d, f"np {n}", tolerance=tol)
         problems += compare_snapshots(serial, d, f"np {n}", tolerance=tol)
         if args.compression:

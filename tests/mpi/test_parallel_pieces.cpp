@@ -98,6 +98,114 @@ TEST(Decomposition, BisectsByParticlesAndCoversEveryCell) {
   EXPECT_FALSE(b.near(0, IVec<2>(42, 3), 2));
 }
 
+/// A 128 x 128 grid with 4 particles per cell, those left of x = 64 costing 3 (weight 3000),
+/// the others 1 (weight 1000): one entry per particle.
+struct TwoCostField {
+  IVec<2> n{128, 128};
+  std::vector<IVec<2>> cells;
+  std::vector<std::int64_t> weights;
+  TwoCostField() {
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i)
+        for (int k = 0; k < 4; ++k) {
+          cells.emplace_back(i, j);
+          weights.push_back(i < 64 ? 3000 : 1000);
+        }
+  }
+};
+
+/// Largest weight of a box over the mean.
+double cost_imbalance(const Decomposition<2>& d, const std::vector<IVec<2>>& cells,
+                      const std::vector<std::int64_t>& weights) {
+  std::vector<std::int64_t> cost(static_cast<std::size_t>(d.n_boxes()), 0);
+  std::int64_t total = 0;
+  for (std::size_t p = 0; p < cells.size(); ++p) {
+    cost[static_cast<std::size_t>(d.owner(cells[p]))] += weights[p];
+    total += weights[p];
+  }
+  return static_cast<double>(*std::max_element(cost.begin(), cost.end())) * d.n_boxes() / static_cast<double>(total);
+}
+
+bool same_boxes(const Decomposition<2>& a, const Decomposition<2>& b) {
+  if (a.n_boxes() != b.n_boxes()) return false;
+  for (int r = 0; r < a.n_boxes(); ++r)
+    if (a.box(r).lo != b.box(r).lo || a.box(r).hi != b.box(r).hi) return false;
+  return true;
+}
+
+TEST(Decomposition, WeightedBisectionGivesEveryBoxTheSameCost) {
+  // Within 3 %: a cut can miss the balancing share by half a slab of cells (at most 1.2 % of a
+  // box's cost here), and the cuts of up to three levels compound. Balancing particle counts
+  // instead leaves the boxes of the costly half 50 % above the mean (2 boxes: 3 x 64 against
+  // 1 x 64 columns).
+  const TwoCostField f;
+  for (int boxes : {2, 3, 4, 5, 8}) {
+    const Decomposition<2> weighted = Decomposition<2>::bisect(Comm::serial(), f.n, {false, false}, f.cells, f.weights, boxes);
+    ASSERT_EQ(weighted.n_boxes(), boxes);
+    EXPECT_LE(cost_imbalance(weighted, f.cells, f.weights), 1.03) << boxes << " boxes";
+    const Decomposition<2> counted = Decomposition<2>::bisect(Comm::serial(), f.n, {false, false}, f.cells, {}, boxes);
+    EXPECT_GE(cost_imbalance(counted, f.cells, f.weights), 1.2) << boxes << " boxes";
+    // The boxes tile the grid: every cell has one owner, and the boxes' cells add up.
+    long long covered = 0;
+    for (int r = 0; r < boxes; ++r) covered += weighted.box(r).n_cells();
+    EXPECT_EQ(covered, 128LL * 128LL);
+  }
+}
+
+TEST(Decomposition, WeightedBisectionIsDeterministic) {
+  // The same particles in another order give the same boxes (integer histograms), and so does
+  // the same run again.
+  TwoCostField f;
+  const Decomposition<2> a = Decomposition<2>::bisect(Comm::serial(), f.n, {false, true}, f.cells, f.weights, 6);
+  const Decomposition<2> b = Decomposition<2>::bisect(Comm::serial(), f.n, {false, true}, f.cells, f.weights, 6);
+  EXPECT_TRUE(same_boxes(a, b));
+  std::vector<std::size_t> order(f.cells.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(11));
+  std::vector<IVec<2>> cells;
+  std::vector<std::int64_t> weights;
+  for (std::size_t p : order) {
+    cells.push_back(f.cells[p]);
+    weights.push_back(f.weights[p]);
+  }
+  EXPECT_TRUE(same_boxes(a, Decomposition<2>::bisect(Comm::serial(), f.n, {false, true}, cells, weights, 6)));
+  EXPECT_THROW(Decomposition<2>::bisect(Comm::serial(), f.n, {false, true}, cells, {1, 2}, 6), std::invalid_argument);
+}
+
+TEST(Decomposition, RebalanceWithinToleranceMovesNoParticle) {
+  // A small imbalance (a few particles more in one box): a rebalance keeps every cut, so no
+  // particle changes box, where a fresh bisection would move cuts.
+  const TwoCostField f;
+  const Decomposition<2> d = Decomposition<2>::bisect(Comm::serial(), f.n, {false, false}, f.cells, f.weights, 4);
+  std::vector<IVec<2>> cells = f.cells;
+  std::vector<std::int64_t> weights = f.weights;
+  const CellBox<2>& first = d.box(0);
+  for (int j = first.lo[1]; j < first.lo[1] + 12; ++j)
+    for (int i = first.lo[0]; i < first.hi[0]; ++i) {
+      cells.emplace_back(i, j);
+      weights.push_back(i < 64 ? 3000 : 1000);
+    }
+  const double before = cost_imbalance(d, cells, weights);
+  EXPECT_GT(before, 1.02);
+  EXPECT_LT(before, 1.05);
+  EXPECT_FALSE(same_boxes(d, Decomposition<2>::bisect(Comm::serial(), f.n, {false, false}, cells, weights, 4)));
+  const Decomposition<2> kept = d.rebalanced(Comm::serial(), cells, weights, 0.05);
+  EXPECT_TRUE(same_boxes(d, kept));
+  for (std::size_t p = 0; p < cells.size(); ++p) ASSERT_EQ(kept.owner(cells[p]), d.owner(cells[p]));
+  // A large imbalance (box 0's particles twice over) moves the cuts out of balance and brings
+  // the cost back within the tolerance compounded over the two levels (and a slab).
+  for (int j = first.lo[1]; j < first.hi[1]; ++j)
+    for (int i = first.lo[0]; i < first.hi[0]; ++i)
+      for (int k = 0; k < 4; ++k) {
+        cells.emplace_back(i, j);
+        weights.push_back(i < 64 ? 3000 : 1000);
+      }
+  EXPECT_GT(cost_imbalance(d, cells, weights), 1.5);
+  const Decomposition<2> moved = d.rebalanced(Comm::serial(), cells, weights, 0.02);
+  EXPECT_FALSE(same_boxes(d, moved));
+  EXPECT_LE(cost_imbalance(moved, cells, weights), 1.06);
+}
+
 TEST(GridWindow, TranslatesBetweenDomainAndStorage) {
   // 20 x 8 cells, x not periodic with 2 ghost layers, y periodic.
   Grid<2> whole(Vec<2>(0.0, 0.0), IVec<2>(20, 8), Vec<2>(0.5, 0.5), 2, {false, true});

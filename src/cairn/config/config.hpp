@@ -55,6 +55,9 @@ struct ParallelConfig {
   /// stencil wide; particles: ghost copies of the neighbours' particles, node sums in serial
   /// order (bit-identical to a serial run); auto: nodes.
   std::string halo = "auto";
+  /// What the bisection balances: count = particles per rank; cost = the particles' measured
+  /// cost per step (their material model's, or the material's balance_cost).
+  std::string balance = "count";
 };
 
 struct GridConfig {

@@ -66,6 +66,7 @@ void Loader::read_parallel(const toml::table& root, Config& cfg) {
   TableReader r(*this, section(root, "parallel"), {"parallel"}, copy_section("parallel"), "[parallel]");
   r.reject_unknown_keys();
   cfg.parallel.halo = r.string("halo");
+  cfg.parallel.balance = r.string("balance");
 }
 
 void Loader::read_body_force(const toml::table& root, Config& cfg) {

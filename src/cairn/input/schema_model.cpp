@@ -74,9 +74,10 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                 .by_default("true"));
   k.push_back(Key("simulation", "rebalance_threshold", T::real,
                  "Runs on several MPI ranks (docs/parallel.md): repartition the domain when the "
-                 "largest particle count of a rank exceeds the mean count by more than this "
-                 "fraction (history column `imbalance` = largest / mean); checked every step. A "
-                 "large value (e.g. 1e9) keeps the start-up partition. Unused on one rank.")
+                 "largest particle count of a rank (its cost with [parallel] balance = \"cost\") "
+                 "exceeds the mean by more than this fraction (history column `imbalance` = "
+                 "largest / mean); checked every step. A repartition moves only the cuts out of "
+                 "balance. A large value (e.g. 1e9) keeps the start-up partition. Unused on one rank.")
                 .by_default("0.25")
                 .min(0.0));
   k.push_back(Key("simulation", "memory_limit", T::real,
@@ -104,6 +105,14 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "they share (for the point clouds of the normals). Unused on one rank.")
                 .by_default("\"auto\"")
                 .choices([] { return std::vector<std::string>{"auto", "nodes", "particles"}; }));
+  k.push_back(Key("parallel", "balance", T::string,
+                 "Runs on several MPI ranks (docs/parallel.md, \"Load balance\"): what the domain "
+                 "bisection shares out equally among the ranks. count = particles; cost = the "
+                 "particles' cost per step, measured per material model (bench/material_cost.py) "
+                 "or set by the material's balance_cost. The history column `imbalance` and "
+                 "simulation.rebalance_threshold then measure the same. Unused on one rank.")
+                .by_default("\"count\"")
+                .choices([] { return std::vector<std::string>{"count", "cost"}; }));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,
                  "Refuse a run whose end_time / first time step exceeds this (a run that would "
                  "never end), naming the material that sets the step; 0 = no check. Not checked "
@@ -214,6 +223,13 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "Heat capacity per unit mass c_p (conduction; heating by plastic and viscous work).")
                 .by_default("0.0")
                 .min(0.0));
+  k.push_back(Key("material", "balance_cost", T::real,
+                 "With [parallel] balance = \"cost\" on several MPI ranks: the cost of a step of "
+                 "one of its particles relative to one of a corotational linear_elastic material; "
+                 "0 = the figure measured for its model (docs/parallel.md, \"Load balance\").")
+                .by_default("0.0")
+                .min(0.0)
+                .max(1000.0));
 
   // [[body]]
   k.push_back(Key("body", "name", T::string,

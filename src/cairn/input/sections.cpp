@@ -182,6 +182,7 @@ void Loader::read_materials(const toml::table& root, Config& cfg) {
     m.numbers["density"] = r.real("density");
     m.numbers["conductivity"] = r.real("conductivity");
     m.numbers["heat_capacity"] = r.real("heat_capacity");
+    m.numbers["balance_cost"] = r.real("balance_cost");
     m.where = {file_, line_of(t)};
 
     const auto info = material_model_info().find(model);

@@ -107,6 +107,7 @@ std::string config_to_toml(const Config& c) {
 
   o += "\n[parallel]\n";
   line("halo", toml_string(c.parallel.halo));
+  line("balance", toml_string(c.parallel.balance));
 
   if (!c.fem.enabled) {
     o += "\n[grid]\n";
@@ -142,6 +143,7 @@ std::string config_to_toml(const Config& c) {
     line("density", real_text(mat.number("density")));
     line("conductivity", real_text(mat.number("conductivity")));
     line("heat_capacity", real_text(mat.number("heat_capacity")));
+    if (mat.has("balance_cost")) line("balance_cost", real_text(mat.number("balance_cost")));
     auto info = material_model_info().find(mat.model);
     if (info == material_model_info().end()) continue;
     for (const auto& d : info->second.keys) {

@@ -132,6 +132,9 @@ class LinearElastic final : public Material {
   int n_state() const override { return beta_ > 0.0 ? 1 : 0; }
   bool uses_increment() const override { return beta_ > 0.0; }
   double damping_time() const override { return beta_; }
+  // bench/material_cost.py (docs/parallel.md, "Load balance"): small_strain skips the polar
+  // decomposition.
+  double relative_cost() const override { return form_ == Form::corotational ? 1.0 : 0.77; }
   double dissipated_energy_density(const double* state) const override {
     return beta_ > 0.0 && state != nullptr ? state[0] : 0.0;
   }

@@ -82,6 +82,10 @@ class Material {
   /// elastic stiffness C (0: none; docs/materials.md, "Damping"). Damps every mode at
   /// zeta = beta omega / 2 and shortens the stable time step, which next_dt accounts for.
   [[nodiscard]] virtual double damping_time() const { return 0.0; }
+  /// The cost of a step of one of its particles relative to one of a corotational linear_elastic
+  /// material (its stress update against the rest of the step), measured by
+  /// bench/material_cost.py: the particle's weight with [parallel] balance = "cost".
+  [[nodiscard]] virtual double relative_cost() const { return 1.0; }
   /// Energy per unit reference volume the model has dissipated (a viscous stress's work), kept
   /// in its state; part of the history's dissipated_energy, not of strain_energy.
   [[nodiscard]] virtual double dissipated_energy_density(const double* state) const {

@@ -84,6 +84,9 @@ class MieGruneisen final : public Material {
   }
   double initial_temperature() const override { return T0_; }
   bool uses_temperature() const override { return true; }
+  // bench/material_cost.py (docs/parallel.md, "Load balance"): with plasticity, the yielding
+  // particles' radial return.
+  double relative_cost() const override { return yield_ > 0.0 ? 1.31 : 1.16; }
 
   /// Pressure from the EOS (Eq. 51, compression branch for eta > 0).
   double pressure(double J, double U) const {

@@ -85,20 +85,41 @@ std::vector<int> Decomposition<D>::neighbours(int rank, int width) const {
 
 template <int D>
 Decomposition<D> Decomposition<D>::bisect(const Comm& comm, const IVec<D>& n_cells,
-                                          const std::array<bool, D>& periodic, const std::vector<IVec<D>>& cells) {
+                                          const std::array<bool, D>& periodic, const std::vector<IVec<D>>& cells,
+                                          const std::vector<std::int64_t>& weights, int n_boxes) {
+  return build(comm, n_boxes > 0 ? n_boxes : comm.size(), n_cells, periodic, cells, weights, nullptr, 0.0);
+}
+
+template <int D>
+Decomposition<D> Decomposition<D>::rebalanced(const Comm& comm, const std::vector<IVec<D>>& cells,
+                                              const std::vector<std::int64_t>& weights, double tolerance) const {
+  return build(comm, n_boxes(), n_cells_, periodic_, cells, weights, this, tolerance);
+}
+
+template <int D>
+Decomposition<D> Decomposition<D>::build(const Comm& comm, int n_boxes, const IVec<D>& n_cells,
+                                         const std::array<bool, D>& periodic, const std::vector<IVec<D>>& cells,
+                                         const std::vector<std::int64_t>& weights, const Decomposition* previous,
+                                         double tolerance) {
+  if (previous && previous->n_boxes() != n_boxes) previous = nullptr;
   Decomposition d(n_cells, periodic);
-  const int n_ranks = comm.size();
   long long total_cells = 1;
   for (int a = 0; a < D; ++a) total_cells *= n_cells[a];
-  if (total_cells < n_ranks)
+  if (total_cells < n_boxes)
     throw std::invalid_argument("the grid has " + std::to_string(total_cells) + " cells, fewer than the " +
-                                std::to_string(n_ranks) + " MPI ranks");
+                                std::to_string(n_boxes) + " MPI ranks");
+  if (!weights.empty() && weights.size() != cells.size())
+    throw std::invalid_argument("domain decomposition: " + std::to_string(weights.size()) + " weights for " +
+                                std::to_string(cells.size()) + " cells");
   std::vector<IVec<D>> local(cells.size());
   for (std::size_t p = 0; p < cells.size(); ++p) local[p] = d.domain_cell(cells[p]);
-  d.boxes_.assign(static_cast<std::size_t>(n_ranks), CellBox<D>{});
+  auto weight = [&](std::size_t p) -> std::int64_t { return weights.empty() ? 1 : weights[p]; };
+  d.boxes_.assign(static_cast<std::size_t>(n_boxes), CellBox<D>{});
   d.cuts_.clear();
 
-  // Depth first; every rank walks the same tree, so the histogram reductions match up.
+  // Depth first; every rank walks the same tree, so the histogram reductions match up. The
+  // rank ranges of the nodes do not depend on the particles, so node k of a rebalanced tree is
+  // node k of the previous one.
   std::function<int(const CellBox<D>&, int, int)> split = [&](const CellBox<D>& box, int r0, int r1) -> int {
     const int node = static_cast<int>(d.cuts_.size());
     d.cuts_.emplace_back();
@@ -108,49 +129,59 @@ Decomposition<D> Decomposition<D>::bisect(const Comm& comm, const IVec<D>& n_cel
       return node;
     }
     const int n_below = (r1 - r0) / 2, n_above = r1 - r0 - n_below;
-    // The longest axis that can be cut with enough cells on both sides for their ranks.
-    long long cross = 1;
+    // An axis can be cut when it leaves enough cells on both sides for their ranks.
+    auto min_width = [&](int a, int ranks) {
+      const long long slab = box.n_cells() / (box.hi[a] - box.lo[a]);  // cells per unit of width
+      return static_cast<int>((ranks + slab - 1) / slab);
+    };
+    auto can_cut = [&](int a) { return box.hi[a] - box.lo[a] >= min_width(a, n_below) + min_width(a, n_above); };
+    // The previous tree's axis when it can still be cut, else the longest axis that can.
+    const Cut* old = previous ? &previous->cuts_[static_cast<std::size_t>(node)] : nullptr;
     int axis = -1;
-    for (int a = 0; a < D; ++a) {
-      const int width = box.hi[a] - box.lo[a];
-      const long long slab = box.n_cells() / width;  // cells per unit of width
-      const int min_lo = static_cast<int>((n_below + slab - 1) / slab);
-      const int min_hi = static_cast<int>((n_above + slab - 1) / slab);
-      if (width < min_lo + min_hi) continue;
-      if (axis < 0 || width > box.hi[axis] - box.lo[axis]) {
-        axis = a;
-        cross = slab;
-      }
+    if (old && old->axis >= 0 && can_cut(old->axis)) {
+      axis = old->axis;
+    } else {
+      for (int a = 0; a < D; ++a)
+        if (can_cut(a) && (axis < 0 || box.hi[a] - box.lo[a] > box.hi[axis] - box.lo[axis])) axis = a;
     }
     if (axis < 0) throw std::invalid_argument("domain decomposition: a box cannot be split among its ranks");
     const int lo = box.lo[axis], width = box.hi[axis] - lo;
     std::vector<std::int64_t> histogram(static_cast<std::size_t>(width), 0);
-    for (const IVec<D>& c : local) {
+    for (std::size_t p = 0; p < local.size(); ++p) {
+      const IVec<D>& c = local[p];
       bool in = true;
       for (int a = 0; a < D && in; ++a) in = c[a] >= box.lo[a] && c[a] < box.hi[a];
-      if (in) ++histogram[static_cast<std::size_t>(c[axis] - lo)];
+      if (in) histogram[static_cast<std::size_t>(c[axis] - lo)] += weight(p);
     }
     comm.sum(histogram.data(), width);
     std::int64_t total = 0;
     for (auto h : histogram) total += h;
-    const int first = lo + static_cast<int>((n_below + cross - 1) / cross);
-    const int last = box.hi[axis] - static_cast<int>((n_above + cross - 1) / cross);
-    // The cut whose share below is closest to n_below / (r1 - r0) of the particles (of the
-    // cells when the box holds none); ties go to the lower plane.
+    const int first = lo + min_width(axis, n_below);
+    const int last = box.hi[axis] - min_width(axis, n_above);
+    // The cut whose share below is closest to n_below / (r1 - r0) of the weight (of the cells
+    // when the box holds none); ties go to the lower plane.
+    auto share_below = [&](int at, std::int64_t below) {
+      return total > 0 ? static_cast<double>(below) / static_cast<double>(total) : static_cast<double>(at - lo) / width;
+    };
+    const double target = static_cast<double>(n_below) / (r1 - r0);
     int best = first;
-    double best_error = -1.0;
+    double best_error = -1.0, kept_share = -1.0;
     std::int64_t below = 0;
     for (int c = lo; c < first; ++c) below += histogram[static_cast<std::size_t>(c - lo)];
     for (int at = first; at <= last; ++at) {
-      const double share = total > 0 ? static_cast<double>(below) / static_cast<double>(total)
-                                      : static_cast<double>(at - lo) / width;
-      const double error = std::abs(share - static_cast<double>(n_below) / (r1 - r0));
+      const double share = share_below(at, below);
+      const double error = std::abs(share - target);
       if (best_error < 0.0 || error < best_error) {
         best_error = error;
         best = at;
       }
+      if (old && old->axis == axis && old->at == at) kept_share = share;
       if (at < box.hi[axis]) below += histogram[static_cast<std::size_t>(at - lo)];
     }
+    // A rebalance keeps the previous cut while the weight per box on each side stays within
+    // the tolerance of the pair's mean: share / target and (1 - share) / (1 - target).
+    if (kept_share >= 0.0 && std::max(kept_share / target, (1.0 - kept_share) / (1.0 - target)) <= 1.0 + tolerance)
+      best = old->at;
     CellBox<D> box_below = box, box_above = box;
     box_below.hi[axis] = best;
     box_above.lo[axis] = best;
@@ -163,7 +194,7 @@ Decomposition<D> Decomposition<D>::bisect(const Comm& comm, const IVec<D>& n_cel
     cut.above = child_above;
     return node;
   };
-  split(CellBox<D>{IVec<D>::Zero(), n_cells}, 0, n_ranks);
+  split(CellBox<D>{IVec<D>::Zero(), n_cells}, 0, n_boxes);
   return d;
 }
 

@@ -42,36 +42,74 @@ void Distribution<D>::partition(Particles<D>& particles) {
     n_owned_ = particles.n();
     return;
   }
-  std::vector<IVec<D>> cells(particles.n());
-  for (std::size_t p = 0; p < particles.n(); ++p) cells[p] = cell_of(particles.position[p]);
-  partition_cells(cells);
+  std::vector<IVec<D>> cells;
+  std::vector<std::int64_t> weights;
+  census(particles, cells, weights);
+  partition_cells(cells, weights);
   migrate(particles);
 }
 
 template <int D>
-void Distribution<D>::partition_cells(const std::vector<IVec<D>>& cells) {
+void Distribution<D>::census(const Particles<D>& particles, std::vector<IVec<D>>& cells,
+                             std::vector<std::int64_t>& weights) const {
+  cells.resize(particles.n());
+  for (std::size_t p = 0; p < particles.n(); ++p) cells[p] = cell_of(particles.position[p]);
+  weights.clear();
+  if (!weights_.empty())
+    for (std::size_t p = 0; p < particles.n(); ++p) weights.push_back(weight_of(particles.material[p]));
+}
+
+template <int D>
+std::int64_t Distribution<D>::rebalance(Particles<D>& particles, double threshold) {
+  if (!active()) return 0;
+  std::vector<IVec<D>> cells;
+  std::vector<std::int64_t> weights;
+  census(particles, cells, weights);
+  int depth = 0;
+  while ((1 << depth) < comm_.size()) ++depth;
+  Decomposition<D> next = decomposition_.rebalanced(comm_, cells, weights, threshold / (2.0 * depth));
+  bool same = true;
+  for (int r = 0; r < next.n_boxes() && same; ++r)
+    same = next.box(r).lo == decomposition_.box(r).lo && next.box(r).hi == decomposition_.box(r).hi;
+  if (same) return 0;  // every cut kept: the boxes, neighbours and halos stay as they are
+  decomposition_ = std::move(next);
+  ++partitions_;
+  band_ = -1;
+  const std::int64_t moved = comm_.sum(static_cast<std::int64_t>(migrate(particles)));
+  ++repartitions_;
+  repartition_moved_ += moved;
+  repartition_most_moved_ = std::max(repartition_most_moved_, moved);
+  return moved;
+}
+
+template <int D>
+void Distribution<D>::partition_cells(const std::vector<IVec<D>>& cells, const std::vector<std::int64_t>& weights) {
   if (!active()) return;
   std::array<bool, D> periodic{};
   for (int a = 0; a < D; ++a) periodic[a] = whole_.periodic(a);
-  decomposition_ = Decomposition<D>::bisect(comm_, whole_.n_cells(), periodic, cells);
+  decomposition_ = Decomposition<D>::bisect(comm_, whole_.n_cells(), periodic, cells, weights);
   ++partitions_;
   band_ = -1;
 }
 
 template <int D>
-double Distribution<D>::imbalance(std::size_t n_owned) const {
+double Distribution<D>::imbalance(const Particles<D>& particles) const {
   if (!active()) return 1.0;
-  const std::int64_t most = comm_.max(static_cast<std::int64_t>(n_owned));
-  const std::int64_t total = comm_.sum(static_cast<std::int64_t>(n_owned));
+  std::int64_t mine = 0;
+  if (weights_.empty()) mine = static_cast<std::int64_t>(particles.n());
+  else
+    for (std::size_t p = 0; p < particles.n(); ++p) mine += weight_of(particles.material[p]);
+  const std::int64_t most = comm_.max(mine);
+  const std::int64_t total = comm_.sum(mine);
   if (total == 0) return 1.0;
   return static_cast<double>(most) * comm_.size() / static_cast<double>(total);
 }
 
 template <int D>
-void Distribution<D>::migrate(Particles<D>& particles) {
+std::size_t Distribution<D>::migrate(Particles<D>& particles) {
   if (!active()) {
     n_owned_ = particles.n();
-    return;
+    return 0;
   }
   const int me = comm_.rank();
   const std::size_t n = particles.n();
@@ -115,6 +153,7 @@ void Distribution<D>::migrate(Particles<D>& particles) {
     reorder_particles(particles, order);
   }
   n_owned_ = particles.n();
+  return n - kept;
 }
 
 template <int D>

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
@@ -41,19 +42,38 @@ class Distribution {
   /// Whether there is more than one rank (otherwise every method below is a no-op).
   [[nodiscard]] bool active() const { return comm_.parallel(); }
   [[nodiscard]] const Decomposition<D>& decomposition() const { return decomposition_; }
-  /// Number of partitions so far (the start-up one, then each repartition).
+  /// Number of partitions so far (the start-up one, then each repartition that changed a box).
   [[nodiscard]] int partitions() const { return partitions_; }
   /// Particles this rank has received from other ranks so far (migration and partitions).
   [[nodiscard]] std::int64_t received() const { return received_; }
 
+  /// Weigh a particle of material m by weights[m] in the bisection and the imbalance (its cost,
+  /// docs/parallel.md "Load balance"); empty (the default): every particle weighs 1, the boxes
+  /// balance particle counts.
+  void set_material_weights(std::vector<std::int64_t> weights) { weights_ = std::move(weights); }
+  [[nodiscard]] std::int64_t weight_of(std::int32_t material) const {
+    return weights_.empty() ? 1 : weights_[static_cast<std::size_t>(material)];
+  }
   /// Bisect the domain among the ranks by the cells of all particles and send each particle to
   /// its owner (collective). `particles` holds this rank's particles (any subset: all of them
   /// after a replicated setup, a slab of a checkpoint, the current owned set).
   void partition(Particles<D>& particles);
+  /// A repartition of the owned `particles` that moves as few as it can: the bisection tree is
+  /// kept and a cut moves only where its sides are out of balance by more than threshold / (2 L)
+  /// (L: the tree's depth, so that the kept cuts compound to about threshold / 2), then the
+  /// particles that changed box migrate (collective). Returns the particles that changed rank,
+  /// over all ranks.
+  std::int64_t rebalance(Particles<D>& particles, double threshold);
+  /// Repartitions so far that changed a box, the particles they moved (over all ranks) and the
+  /// most one moved.
+  [[nodiscard]] int repartitions() const { return repartitions_; }
+  [[nodiscard]] std::int64_t repartition_moved() const { return repartition_moved_; }
+  [[nodiscard]] std::int64_t repartition_most_moved() const { return repartition_most_moved_; }
   /// Bisect the domain by the cells `cells` (this rank's part of a census of every particle, any
-  /// split of it over the ranks: the bisection sums the ranks' histograms) without moving
-  /// particles: per-rank generation then creates each rank's particles in place (collective).
-  void partition_cells(const std::vector<IVec<D>>& cells);
+  /// split of it over the ranks: the bisection sums the ranks' histograms) and their `weights`
+  /// (empty: 1 each) without moving particles: per-rank generation then creates each rank's
+  /// particles in place (collective).
+  void partition_cells(const std::vector<IVec<D>>& cells, const std::vector<std::int64_t>& weights = {});
   /// Take `particles` as this rank's owned particles (they must lie in its box, in increasing
   /// id), as after a partition.
   void adopt(const Particles<D>& particles) { n_owned_ = particles.n(); }
@@ -62,13 +82,15 @@ class Distribution {
   [[nodiscard]] IVec<D> cell_of(const Vec<D>& x) const;
   /// The rank whose box holds the particle at x.
   [[nodiscard]] int owner_of(const Vec<D>& x) const { return decomposition_.owner(cell_of(x)); }
-  /// Largest particle count of a rank over the mean count (1 for a serial run; collective).
-  [[nodiscard]] double imbalance(std::size_t n_owned) const;
+  /// Largest weight of a rank's `particles` (all of them owned) over the mean weight: with unit
+  /// weights the largest particle count over the mean count (1 for a serial run; collective).
+  [[nodiscard]] double imbalance(const Particles<D>& particles) const;
   /// Send the particles that left this rank's box to their owners and take in those that
   /// entered it; the owned particles stay in increasing id (collective), unless
   /// keep_storage_order(true): then the staying particles keep their storage order and the
-  /// arrivals follow them (the node halo, whose storage is sorted by cell block).
-  void migrate(Particles<D>& particles);
+  /// arrivals follow them (the node halo, whose storage is sorted by cell block). Returns the
+  /// particles that left this rank.
+  std::size_t migrate(Particles<D>& particles);
   void keep_storage_order(bool keep) { keep_storage_order_ = keep; }
 
   /// Ghost band B and window margin W for stencils of reach r (see above).
@@ -109,10 +131,15 @@ class Distribution {
   }
 
  private:
+  /// The cells of `particles` and, with material weights, their weights.
+  void census(const Particles<D>& particles, std::vector<IVec<D>>& cells, std::vector<std::int64_t>& weights) const;
   Comm comm_ = Comm::serial();
   Grid<D> whole_;
   Decomposition<D> decomposition_;
   int partitions_ = 0;
+  int repartitions_ = 0;
+  std::int64_t repartition_moved_ = 0, repartition_most_moved_ = 0;
+  std::vector<std::int64_t> weights_;  ///< per material; empty: 1
   std::int64_t received_ = 0;
   std::size_t n_owned_ = 0;
   int band_ = -1;                                  ///< ghost band of the neighbour list

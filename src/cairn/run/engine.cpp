@@ -201,7 +201,7 @@ const std::vector<std::string>& restart_keys() {
       "simulation.end_time",        "simulation.max_steps",       "simulation.threads",
       "simulation.adapt_threads",   "simulation.sort_particles",  "simulation.rebalance_threshold",
       "simulation.memory_limit",    "simulation.max_estimated_steps", "simulation.mpi_timeout",
-      "parallel.halo",
+      "parallel.halo",              "parallel.balance",
       "output.directory",           "output.every",               "output.history_every",
       "output.checkpoint_every",    "output.checkpoint_wall_interval", "output.checkpoints",
       "output.snapshots",           "output.grid_snapshots",      "output.compression"};

@@ -352,6 +352,10 @@ class MpmEngine final : public Engine {
     }
     summary.migrated = comm_.sum(sim_.distribution().received());
     summary.max_imbalance = max_imbalance_;
+    summary.balance = sim_.config().parallel.balance;
+    summary.repartitions = sim_.distribution().repartitions();
+    summary.repartition_moved = sim_.distribution().repartition_moved();
+    summary.repartition_most_moved = sim_.distribution().repartition_most_moved();
     summary.particle_steps_per_second =
         summary.wall_seconds > 0 ? static_cast<double>(summary.steps) * summary.n_particles / summary.wall_seconds : 0.0;
     summary.output_directory = dir_;

@@ -31,7 +31,10 @@ struct RunSummary {
   double halo_cloud_bytes_per_step = 0.0;  ///< of them, particles of contact nodes (node halo with contact)
   int partitions = 0;           ///< domain partitions (start-up and repartitions), several ranks
   long long migrated = 0;       ///< particles that moved between ranks
-  double max_imbalance = 1.0;   ///< largest particle imbalance seen at a step's start
+  double max_imbalance = 1.0;   ///< largest imbalance (of counts or costs) seen at a step's start
+  std::string balance;          ///< parallel.balance: what the imbalance measures (count | cost)
+  int repartitions = 0;         ///< repartitions during the run (not the start-up partition)
+  long long repartition_moved = 0, repartition_most_moved = 0;  ///< particles they moved; most in one
   std::filesystem::path output_directory;
   std::filesystem::path last_checkpoint;
   /// Wall seconds per pipeline stage of Simulation::step (stencils, particles_to_grid, ...).

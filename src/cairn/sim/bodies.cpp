@@ -152,6 +152,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
                       const GenerationShare<D>* share) {
   const double thickness = D == 3 ? 1.0 : config.simulation.thickness;
   const std::size_t n_bodies = config.bodies.size();
+  const int margin = share && share->decomposition ? share->margin : 0;  // > 0: select only, no checks
   // Over every generated particle, stored or not (per-rank generation stores a subset).
   std::int64_t next_id = static_cast<std::int64_t>(particles.n());
   std::vector<std::size_t> count_of(n_bodies, 0);
@@ -334,7 +335,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
       auto test = [&](long long k) {
         const Vec<D> X = lattice_point(k);
         if (!inside<D>(body.shape, image.get(), line_of[b], X)) return false;
-        tally(X, vol);
+        if (margin == 0) tally(X, vol);
         mine.push_back(k);
         return true;
       };
@@ -363,17 +364,17 @@ void create_particles(const Config& config, const Grid<D>& grid,
         const CellBox<D>& cells = dec.box(comm.rank());
         std::array<long long, 3> lo{0, 0, 0}, hi{0, 0, 0};  // this rank's points, inclusive, from box.lo
         for (int a = 0; a < D; ++a) {
-          lo[a] = std::max(box.lo[a], static_cast<long long>(cells.lo[a]) * ppc[a]) - box.lo[a];
-          hi[a] = std::min(box.hi[a], static_cast<long long>(cells.hi[a]) * ppc[a] - 1) - box.lo[a];
+          lo[a] = std::max(box.lo[a], static_cast<long long>(cells.lo[a] - margin) * ppc[a]) - box.lo[a];
+          hi[a] = std::min(box.hi[a], static_cast<long long>(cells.hi[a] + margin) * ppc[a] - 1) - box.lo[a];
         }
-        std::vector<std::int64_t> count(static_cast<std::size_t>(rows * n_seg), 0);
+        std::vector<std::int64_t> count(margin == 0 ? static_cast<std::size_t>(rows * n_seg) : 0, 0);
         const long long stride2 = D == 3 ? span[std::min(1, D - 1)] : 0;  // rows per z layer
         if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
           for (long long i2 = lo[2]; i2 <= hi[2]; ++i2)
             for (long long i1 = lo[1]; i1 <= hi[1]; ++i1) {
               const long long row = i1 + stride2 * i2;
               for (long long i0 = lo[0]; i0 <= hi[0]; ++i0)
-                if (test(i0 + span[0] * row)) ++count[static_cast<std::size_t>(row * n_seg + segment(i0))];
+                if (test(i0 + span[0] * row) && margin == 0) ++count[static_cast<std::size_t>(row * n_seg + segment(i0))];
             }
         constexpr std::size_t chunk = 1u << 24;
         for (std::size_t at = 0; at < count.size(); at += chunk)
@@ -381,12 +382,17 @@ void create_particles(const Config& config, const Grid<D>& grid,
         std::int64_t before = 0;  // count -> the first id offset of each (row, segment)
         for (auto& c : count) before += std::exchange(c, before);
         for (long long k : mine) {
+          if (margin > 0) {
+            id_of.push_back(-1);
+            continue;
+          }
           const long long row = k / span[0];
           std::int64_t& at = count[static_cast<std::size_t>(row * n_seg + segment(k % span[0]))];
           id_of.push_back(next_id + at++);
         }
       }
       for (std::size_t j = 0; j < mine.size(); ++j) emit(mine[j], lattice_point(mine[j]), id_of[j], vol, mass, false);
+      if (margin > 0) continue;  // a selecting walk: no ids, counts or checks
       // The body's count and overlaps over every rank (each point was tested by one rank).
       std::vector<std::int64_t> sums(n_bodies + 1, 0);
       sums[0] = static_cast<std::int64_t>(count_of[b]);
@@ -427,7 +433,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
                                        box.count() == 0.0 ? " inside the grid" : ""));
     }
   }
-  check_overlaps(config, shared, count_of);
+  if (margin == 0) check_overlaps(config, shared, count_of);
   // Initial stresses of pre-deformed bodies (a displacement, or a point file's stresses).
   for (std::size_t p = 0; p < particles.n(); ++p) {
     if (particles.deformation_gradient[p].isIdentity(0.0)) continue;

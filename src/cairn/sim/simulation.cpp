@@ -58,19 +58,33 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // each lattice body and records the cells of its particles (and of every size-th particle
     // of the bodies all ranks generate whole): the histograms, summed over the ranks, are those
     // of all particles. The domain is bisected by them, and the second time each rank tests and
-    // stores only the lattice points of its own box.
+    // stores only the lattice points of its own box. With parallel.balance = "cost" each census
+    // entry weighs what a particle of its body's material costs.
     distribution_ = Distribution<D>(comm, whole_);
+    distribution_.set_material_weights(material_weights());
+    std::vector<std::int64_t> body_weight;
+    for (const BodyConfig& body : config_.bodies) {
+      std::int64_t w = 1;  // (a body naming no material is refused by create_particles)
+      for (std::size_t m = 0; m < config_.materials.size(); ++m)
+        if (config_.materials[m].name == body.material) w = distribution_.weight_of(static_cast<std::int32_t>(m));
+      body_weight.push_back(w);
+    }
+    const bool weighed = config_.parallel.balance == "cost";
     const auto rank = static_cast<std::int64_t>(comm.rank()), ranks = static_cast<std::int64_t>(comm.size());
     std::vector<IVec<D>> census;
-    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t, const Vec<D>&, const Vec<D>& x,
+    std::vector<std::int64_t> census_weight;
+    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t body, const Vec<D>&, const Vec<D>& x,
                                            bool replicated) {
-      if (!replicated || id % ranks == rank) census.push_back(distribution_.cell_of(x));
+      if (replicated && id % ranks != rank) return false;
+      census.push_back(distribution_.cell_of(x));
+      if (weighed) census_weight.push_back(body_weight[static_cast<std::size_t>(body)]);
       return false;
     };
     const GenerationShare<D> rows{&comm, nullptr};
     create_particles<D>(config_, grid_, materials_, mode_, particles_, &count, &rows);
-    distribution_.partition_cells(census);
+    distribution_.partition_cells(census, census_weight);
     std::vector<IVec<D>>().swap(census);
+    std::vector<std::int64_t>().swap(census_weight);
     const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x, bool) {
       return distribution_.owner_of(x) == comm.rank();
     };
@@ -181,7 +195,8 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   if (comm.parallel() && !config_.tractions.empty()) {
     // A face is exposed when its body has no particle in the lattice site across it, which may
     // belong to another rank: a third walk over the bodies records which of those sites hold a
-    // particle.
+    // particle. The sites across this rank's faces lie within a cell of its box, so of a lattice
+    // body the walk tests only the points in the box widened by one cell.
     std::vector<std::unordered_set<std::int64_t>> across(config_.bodies.size()), occupied(config_.bodies.size());
     for (std::size_t p = 0; p < particles_.n(); ++p)
       for (int a = 0; a < D; ++a)
@@ -199,7 +214,8 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     };
     Particles<D> none;
     none.n_state_per_particle = particles_.n_state_per_particle;
-    create_particles<D>(config_, grid_, materials_, mode_, none, &sites);
+    const GenerationShare<D> near{&comm, &distribution_.decomposition(), 1};
+    create_particles<D>(config_, grid_, materials_, mode_, none, &sites, &near);
     tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain(), occupied, comm);
   } else {
     tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
@@ -273,6 +289,19 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     wls_->collect(grid_, particles_, material_density_, body_force_.empty() ? nullptr : &body_acceleration_,
                   nodes_, body_force_.empty() ? nullptr : &node_body_force_);
   }
+}
+
+template <int D>
+std::vector<std::int64_t> Simulation<D>::material_weights() const {
+  if (config_.parallel.balance != "cost") return {};
+  std::vector<std::int64_t> weights;
+  for (std::size_t m = 0; m < materials_.size(); ++m) {
+    const MaterialConfig& mc = config_.materials[m];
+    const double given = mc.has("balance_cost") ? mc.number("balance_cost") : 0.0;
+    const double cost = given > 0.0 ? given : materials_[m]->relative_cost();
+    weights.push_back(std::max<std::int64_t>(1, std::llround(1000.0 * cost)));
+  }
+  return weights;
 }
 
 template <int D>

@@ -212,6 +212,11 @@ class Simulation {
   /// A node-halo step's start: migration and stencils of the owned particles on a window one
   /// reach (and a cell, for traction faces) beyond the box, then the halo's shared nodes.
   void distribute_nodes_and_build();
+  /// Both: migration, the imbalance, and a repartition beyond simulation.rebalance_threshold.
+  void migrate_and_rebalance();
+  /// The bisection's weight of a particle of each material (parallel.balance = "cost": the
+  /// model's measured cost or the material's balance_cost, in thousandths; else none).
+  [[nodiscard]] std::vector<std::int64_t> material_weights() const;
   /// The largest stencil reach over the ranks (collective): when it exceeds reach_, reach_ takes
   /// it and true is returned (the windows must widen); otherwise the cache records it.
   bool widened_to_global_reach();
@@ -358,11 +363,15 @@ using ParticleSelection =
 /// (no point file or mesh elements, no radial arrangement, no WLS surface particles, no
 /// displacement), so that each runs the inside tests of only its own points. Without a
 /// decomposition (the census that decides it) rank r takes the r-th block of lattice rows;
-/// with one, the points in the cells of its box. Other bodies are generated whole on every rank.
+/// with one, the points in the cells of its box, widened by `margin` cells. Other bodies are
+/// generated whole on every rank. A margin makes neighbouring ranks test the same points: such a
+/// walk only selects (the ids it passes mean nothing) and skips the generation's checks, which a walk
+/// without a margin has made.
 template <int D>
 struct GenerationShare {
   const Comm* comm = nullptr;
   const Decomposition<D>* decomposition = nullptr;
+  int margin = 0;
 };
 
 /// Fill `particles` from the [[body]] tables (sim/bodies.cpp): all of them, or those `select`

@@ -213,6 +213,17 @@ bool Simulation<D>::widened_to_global_reach() {
 }
 
 template <int D>
+void Simulation<D>::migrate_and_rebalance() {
+  // Particles that crossed into another box move there; the imbalance (of particle counts or
+  // costs, parallel.balance) is measured on the result, and beyond the threshold the cuts that
+  // are out of balance move (docs/parallel.md, "Load balance").
+  distribution_.migrate(particles_);
+  imbalance_ = distribution_.imbalance(particles_);
+  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold)
+    distribution_.rebalance(particles_, config_.simulation.rebalance_threshold);
+}
+
+template <int D>
 void Simulation<D>::distribute_nodes_and_build() {
   const Comm& comm = distribution_.comm();
   // Storage sorted by cell block as in a serial run (the last colouring still indexes it), then
@@ -220,9 +231,7 @@ void Simulation<D>::distribute_nodes_and_build() {
   keep_particles_sorted(false);
   const std::size_t n_before = particles_.n();
   const std::int64_t received_before = distribution_.received();
-  distribution_.migrate(particles_);
-  imbalance_ = distribution_.imbalance(particles_.n());
-  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) distribution_.partition(particles_);
+  migrate_and_rebalance();
   if (particles_.n() != n_before || distribution_.received() != received_before)
     cache_.colouring_valid = false;  // block_of and order index the storage before the migration
   for (;;) {
@@ -258,11 +267,7 @@ void Simulation<D>::distribute_and_build() {
     return;
   }
   const Comm& comm = distribution_.comm();
-  // Particles that crossed into another box move there; the imbalance is measured on the
-  // result, and beyond the threshold the boxes are bisected anew (docs/parallel.md).
-  distribution_.migrate(particles_);
-  imbalance_ = distribution_.imbalance(particles_.n());
-  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) distribution_.partition(particles_);
+  migrate_and_rebalance();
   for (;;) {
     distribution_.add_ghosts(particles_, reach_);
     set_window(distribution_.window(whole_, reach_));
