@@ -6,6 +6,8 @@
   - a simulation failure (a particle driven out of the grid) exits 3, names the same step, time,
     particle and position as the serial run (particles are named by id on every rank count),
     writes failure.xdmf and the same history.csv as the serial run;
+  - an initial stress of a point file that the material cannot carry is refused at the same row
+    as serially (the ranks share the file's rows out), exit 2, printed once;
   - the methods that run on one rank only (the WLS method, method.integration = "wls", and the
     reference FEM, [fem]) are refused on several ranks with exit 2 and one message from rank 0
     naming the case file and docs/parallel.md.
@@ -76,6 +78,25 @@ def main():
             (d_s / "history.csv").read_text().splitlines():
         problems.append("failure: history.csv differs from the serial one (imbalance column aside)")
 
+    # An initial stress a material cannot carry, in a point file whose rows the ranks share out
+    # (sim/bodies.cpp): refused at the same row as serially, once, exit 2, whichever rank solved it.
+    (args.out / "stressed.csv").write_text(
+        "x,y,volume,sxx,syy,sxy\n" + "".join(
+            f"{0.3 + 0.05 * i},0.3,1e-4,{1.0e15 if i == 7 else 1.0e3},0,0\n" for i in range(9)))
+    stressed = args.out / "stressed.toml"
+    stressed.write_text(
+        "[simulation]\ndimension = 2\nend_time = 1e-4\n[grid]\norigin = [0.0, 0.0]\nextent = [1.0, 0.5]\n"
+        "cell_size = 0.05\n[[material]]\nname = \"m\"\nmodel = \"neo_hookean\"\ndensity = 1000.0\n"
+        "youngs_modulus = 1.0e6\npoissons_ratio = 0.3\n[[body]]\nmaterial = \"m\"\n"
+        "shape = { points = { file = \"stressed.csv\" } }\n")
+    rc_s, err_s = run([args.cairn, "run", stressed])
+    rc_m, err_m = run(mpirun + [args.cairn, "run", stressed])
+    lines_s, lines_m = cairn_lines(err_s), cairn_lines(err_m)
+    if rc_s != 2 or rc_m != 2:
+        problems.append(f"refused initial stress: exit {rc_m} on {args.np} ranks, {rc_s} serially (expected 2)")
+    if len(lines_m) != 1 or lines_m != lines_s or "particle 8 of" not in lines_m[0]:
+        problems.append(f"refused initial stress: {args.np} ranks printed {lines_m}, serially {lines_s}")
+
     # One-rank methods: refused on several ranks, once, exit 2.
     refused = [("wls", [args.cairn, "run", args.case, "--set", 'method.integration="wls"'])]
     if args.fem_case:
@@ -91,7 +112,7 @@ def main():
     if problems:
         print(f"RESULT: FAIL errors on {args.np} ranks ({len(problems)} problems)")
         return 1
-    print(f"RESULT: PASS errors on {args.np} ranks: input error once with exit 2, failure with exit 3 as serially, WLS/FEM refused once with exit 2")
+    print(f"RESULT: PASS errors on {args.np} ranks: input error once with exit 2, failure with exit 3 as serially, refused initial stress as serially, WLS/FEM refused once with exit 2")
     return 0
 
 

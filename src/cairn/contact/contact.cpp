@@ -289,11 +289,12 @@ void Contact<D>::build_clouds(const Particles<D>& particles, const TransferCache
   const std::size_t nc = nodes_.size();
   const auto np = static_cast<std::int64_t>(particles.n());
   // Node halo: the other ranks' particles at the contact nodes this window shares with theirs.
-  std::vector<std::int32_t> ghost_node, ghost_ref;
-  std::vector<double> ghost_weight;
+  ghost_node_.clear();
+  ghost_ref_.clear();
+  ghost_weight_.clear();
   ghosts_.clear();
   const bool halo = halo_ != nullptr && halo_->n_neighbours() > 0;
-  if (halo) exchange_cloud_particles(particles, cache, ghost_node, ghost_ref, ghost_weight);
+  if (halo) exchange_cloud_particles(particles, cache, ghost_node_, ghost_ref_, ghost_weight_);
   cloud_begin_.assign(nc + 1, 0);
   // Particles in increasing id (a distributed run's ghosts included; a serial run's particles
   // kept in cell-block order), as in a serial run in creation order. (Under a node halo each
@@ -307,11 +308,12 @@ void Contact<D>::build_clouds(const Particles<D>& particles, const TransferCache
       const std::int32_t c = contact_of_[static_cast<std::size_t>(node)];
       if (c >= 0 && S > 0.0) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
     });
-  for (std::int32_t c : ghost_node) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
+  for (std::int32_t c : ghost_node_) ++cloud_begin_[static_cast<std::size_t>(c) + 1];
   for (std::size_t c = 0; c < nc; ++c) cloud_begin_[c + 1] += cloud_begin_[c];
   cloud_.resize(static_cast<std::size_t>(cloud_begin_[nc]));
   cloud_weight_.resize(cloud_.size());
-  std::vector<std::int32_t> cursor(cloud_begin_.begin(), cloud_begin_.end() - 1);
+  std::vector<std::int32_t>& cursor = cloud_cursor_;
+  cursor.assign(cloud_begin_.begin(), cloud_begin_.end() - 1);
   for (std::int64_t k = 0; k < np; ++k) {
     const std::int64_t p = particle_at(k);
     for_each_entry(cache, static_cast<std::size_t>(p), [&](std::int32_t node, double S, const Vec<D>&) {
@@ -324,17 +326,17 @@ void Contact<D>::build_clouds(const Particles<D>& particles, const TransferCache
     });
   }
   if (!halo) return;
-  for (std::size_t e = 0; e < ghost_node.size(); ++e) {
-    const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(ghost_node[e])]++);
-    cloud_[at] = ghost_ref[e];
-    cloud_weight_[at] = ghost_weight[e];
+  for (std::size_t e = 0; e < ghost_node_.size(); ++e) {
+    const auto at = static_cast<std::size_t>(cursor[static_cast<std::size_t>(ghost_node_[e])]++);
+    cloud_[at] = ghost_ref_[e];
+    cloud_weight_[at] = ghost_weight_[e];
   }
   // Every cloud in increasing id: the order of the serial run, and the same on every rank that
   // holds the node, so that all copies of a shared node fit the same points in the same order
   // and get the same bits.
-  std::vector<std::pair<std::int64_t, std::int32_t>> order;
-  std::vector<std::int32_t> refs;
-  std::vector<double> weights;
+  auto& order = sort_order_;
+  auto& refs = sort_refs_;
+  auto& weights = sort_weights_;
   for (std::size_t c = 0; c < nc; ++c) {
     const auto b = static_cast<std::size_t>(cloud_begin_[c]), e = static_cast<std::size_t>(cloud_begin_[c + 1]);
     order.clear();
@@ -388,12 +390,7 @@ void Contact<D>::exchange_cloud_particles(const Particles<D>& particles, const T
   const std::size_t nk = halo_->n_neighbours();
   cloud_send_.resize(nk);
   for (auto& b : cloud_send_) b.clear();
-  struct Entry {
-    std::size_t k;
-    std::int32_t row;
-    double S;
-  };
-  std::vector<Entry> entries;
+  auto& entries = halo_entries_;
   for (std::size_t p = 0; p < particles.n(); ++p) {
     entries.clear();
     for_each_entry(cache, p, [&](std::int32_t node, double S, const Vec<D>&) {
@@ -401,7 +398,7 @@ void Contact<D>::exchange_cloud_particles(const Particles<D>& particles, const T
       for (const auto& h : halo_->holders_of(node)) entries.push_back({h.k, static_cast<std::int32_t>(h.s), S});
     });
     if (entries.empty()) continue;
-    std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.k < b.k; });
+    std::stable_sort(entries.begin(), entries.end(), [](const HaloEntry& a, const HaloEntry& b) { return a.k < b.k; });
     for (std::size_t i = 0; i < entries.size();) {
       std::size_t j = i;
       while (j < entries.size() && entries[j].k == entries[i].k) ++j;

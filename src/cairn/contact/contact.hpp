@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cairn/contact/law.hpp"
@@ -194,6 +195,20 @@ class Contact {
   };
   NodeHalo<D>* halo_ = nullptr;
   Ghosts ghosts_;
+  // build_clouds' scratch, kept between steps (no allocation in a step once the largest has run):
+  // the other ranks' cloud entries (contact node, cloud reference, weight), each cloud's next
+  // free place, and one cloud's (id, place) order with its references and weights while sorted.
+  std::vector<std::int32_t> ghost_node_, ghost_ref_, cloud_cursor_, sort_refs_;
+  std::vector<double> ghost_weight_, sort_weights_;
+  std::vector<std::pair<std::int64_t, std::int32_t>> sort_order_;
+  /// exchange_cloud_particles' scratch: one particle's stencil entries at shared contact nodes
+  /// (neighbour k, row in the shared list, weight).
+  struct HaloEntry {
+    std::size_t k;
+    std::int32_t row;
+    double S;
+  };
+  std::vector<HaloEntry> halo_entries_;
   bool need_radius_ = false;  ///< LR separations read each cloud particle's F and initial size
   Comm::Buffers cloud_send_;  ///< node halo: per neighbour, kept between steps
 

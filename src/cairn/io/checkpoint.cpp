@@ -12,6 +12,7 @@
 #include "cairn/io/checksum.hpp"
 #include "cairn/config/errors.hpp"
 #include "cairn/io/hdf5_util.hpp"
+#include "cairn/parallel/agree.hpp"
 #include "cairn/util/child_process.hpp"
 
 namespace cairn {
@@ -526,19 +527,10 @@ void check_readable_by_hdf5(const fs::path& path) {
 
 std::string checkpoint_engine(const fs::path& path, const Comm& comm) {
   if (comm.parallel()) {  // one reading child for the job, not one per rank
-    std::string engine, problem = "0";  // "0", or "2"/"1" (input error / other) and the message
-    if (comm.is_root()) {
-      try {
-        engine = checkpoint_engine(path, Comm::serial());
-      } catch (const InputError& e) {
-        problem = std::string("2") + e.what();
-      } catch (const std::exception& e) {
-        problem = std::string("1") + e.what();
-      }
-    }
-    comm.broadcast(problem, 0);
-    if (problem[0] == '2') throw std::invalid_argument(problem.substr(1));
-    if (problem[0] == '1') throw std::runtime_error(problem.substr(1));
+    std::string engine;
+    agree_on_errors(comm, [&] {
+      if (comm.is_root()) engine = checkpoint_engine(path, Comm::serial());
+    });
     comm.broadcast(engine, 0);
     return engine;
   }

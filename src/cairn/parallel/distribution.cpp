@@ -107,6 +107,16 @@ double Distribution<D>::imbalance(const Particles<D>& particles) const {
 
 template <int D>
 std::size_t Distribution<D>::migrate(Particles<D>& particles) {
+  return send_to_owners(particles, false);
+}
+
+template <int D>
+void Distribution<D>::place(Particles<D>& particles) {
+  send_to_owners(particles, true);
+}
+
+template <int D>
+std::size_t Distribution<D>::send_to_owners(Particles<D>& particles, bool generated) {
   if (!active()) {
     n_owned_ = particles.n();
     return 0;
@@ -119,7 +129,10 @@ std::size_t Distribution<D>::migrate(Particles<D>& particles) {
   for (std::size_t p = 0; p < n; ++p) {
     const Vec<D> xi = whole_.to_cell_units(particles.position[p]);
     // A particle that left the grid stays where it is; its stencil build reports it.
-    const int owner = Grid<D>::indexable(xi) ? decomposition_.owner(whole_.cell_of(particles.position[p])) : me;
+    // (A generated particle goes where the generation's selection would have kept it.)
+    const int owner = generated                 ? owner_of(particles.position[p])
+                      : Grid<D>::indexable(xi) ? decomposition_.owner(whole_.cell_of(particles.position[p]))
+                                               : me;
     if (owner == me) staying.push_back(static_cast<std::int32_t>(p));
     else leaving[static_cast<std::size_t>(owner)].push_back(static_cast<std::int32_t>(p));
   }
@@ -134,7 +147,7 @@ std::size_t Distribution<D>::migrate(Particles<D>& particles) {
   std::size_t arrived = 0;
   for (const auto& buffer : recv)
     if (!buffer.empty()) arrived += unpack_particles(particles, buffer);
-  received_ += static_cast<std::int64_t>(arrived);
+  if (!generated) received_ += static_cast<std::int64_t>(arrived);
   // Owned particles in increasing id: the kept ones already are (unless they came from a
   // checkpoint slab or a replicated setup in another order), the arrivals are sorted and merged.
   const bool kept_sorted = std::is_sorted(particles.id.begin(), particles.id.begin() + static_cast<std::ptrdiff_t>(kept));

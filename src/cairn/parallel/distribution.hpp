@@ -74,9 +74,6 @@ class Distribution {
   /// (empty: 1 each) without moving particles: per-rank generation then creates each rank's
   /// particles in place (collective).
   void partition_cells(const std::vector<IVec<D>>& cells, const std::vector<std::int64_t>& weights = {});
-  /// Take `particles` as this rank's owned particles (they must lie in its box, in increasing
-  /// id), as after a partition.
-  void adopt(const Particles<D>& particles) { n_owned_ = particles.n(); }
   /// The cell that decides the owner of a particle at x (cells beyond a face count for the
   /// boundary cell, periodic axes wrap; far outside the grid: the boundary box).
   [[nodiscard]] IVec<D> cell_of(const Vec<D>& x) const;
@@ -91,6 +88,11 @@ class Distribution {
   /// arrivals follow them (the node halo, whose storage is sorted by cell block). Returns the
   /// particles that left this rank.
   std::size_t migrate(Particles<D>& particles);
+  /// After per-rank generation (partition_cells, then each rank's particles): take the
+  /// generated `particles` as this rank's own, sending those outside its box (a rank's share of
+  /// a body not split by boxes: sim/bodies.cpp) to the rank owner_of names, in increasing id
+  /// (collective; not counted in received()).
+  void place(Particles<D>& particles);
   void keep_storage_order(bool keep) { keep_storage_order_ = keep; }
 
   /// Ghost band B and window margin W for stencils of reach r (see above).
@@ -133,6 +135,8 @@ class Distribution {
  private:
   /// The cells of `particles` and, with material weights, their weights.
   void census(const Particles<D>& particles, std::vector<IVec<D>>& cells, std::vector<std::int64_t>& weights) const;
+  /// migrate(), or with `generated` place(): owners by owner_of, arrivals not counted.
+  std::size_t send_to_owners(Particles<D>& particles, bool generated);
   Comm comm_ = Comm::serial();
   Grid<D> whole_;
   Decomposition<D> decomposition_;

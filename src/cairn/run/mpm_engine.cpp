@@ -22,6 +22,7 @@
 #include "cairn/input/input.hpp"
 #include "cairn/io/output_schedule.hpp"
 #include "cairn/io/snapshot.hpp"
+#include "cairn/parallel/agree.hpp"
 #include "cairn/run/engine.hpp"
 #include "cairn/run/mpm_check.hpp"
 #include "cairn/sim/resources.hpp"
@@ -631,19 +632,7 @@ std::unique_ptr<Engine> restore_dim(const std::filesystem::path& file, const std
   {
     const Comm world = Comm::world();
     const auto first_row = static_cast<std::size_t>(world.exclusive_prefix(static_cast<std::int64_t>(data.particles.n())));
-    std::string problem;
-    try {
-      check_checkpoint_values<D>(file, data, first_row);
-    } catch (const InputError& e) {
-      if (!world.parallel()) throw;
-      problem = e.what();
-    }
-    const std::int64_t first_bad =
-        world.min(problem.empty() ? std::int64_t{world.size()} : std::int64_t{world.rank()});
-    if (first_bad < world.size()) {
-      world.broadcast(problem, static_cast<int>(first_bad));
-      throw std::invalid_argument(problem);
-    }
+    agree_on_errors(world, [&] { check_checkpoint_values<D>(file, data, first_row); });
   }
   const Config config = load_config_string(data.config_toml, file.string(), overrides);
   // (--set cannot change the dimension or the engine: restore_engine refuses those keys.)

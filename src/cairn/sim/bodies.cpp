@@ -36,6 +36,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -274,26 +275,29 @@ void create_particles(const Config& config, const Grid<D>& grid,
           if (inside<D>(config.bodies[a].shape, image_of[a].get(), line_of[a], X)) ++shared[b][a];
       ++count_of[b];
     };
+    // The stretch that carries a point file's initial stress on row `row` (none without stresses);
+    // an InputError when the material cannot carry it.
+    auto stretch_of = [&](std::size_t row) -> std::optional<Mat3> {
+      if (!stressed) return std::nullopt;
+      SymMat3 sigma0;
+      sigma0.voigt() = points->stress[row];
+      std::optional<Mat3> stretch = initial_stretch(*materials[mat], sigma0.full(), D < 3, mode == Mode::plane_stress);
+      if (!stretch)
+        throw InputError(body.where.file, body.where.line, fmt::format("body[{}].shape.points.file", b),
+                         fmt::format("initial stresses that material '{}' can carry (a stretch F0 with "
+                                     "tau(F0) = det(F0) sigma0)",
+                                     body.material),
+                         fmt::format("particle {} of '{}' (xx, yy, zz, yz, xz, xy = {}): no such stretch found",
+                                     row + 1, points->file, fmt::join(points->stress[row], ", ")));
+      return stretch;
+    };
     // The particle: stored when `select` keeps it. `k`: its lattice point, or n_lattice + its seed.
     auto emit = [&](long long k, const Vec<D>& X, std::int64_t id, double particle_volume, double particle_mass,
-                    bool replicated) {
+                    bool in_share) {
       const std::size_t row = static_cast<std::size_t>(k - n_lattice);
-      // (solved on every rank for every row, so that a refusal is the same on all of them)
-      std::optional<Mat3> stretch;
-      if (stressed) {
-        SymMat3 sigma0;
-        sigma0.voigt() = points->stress[row];
-        stretch = initial_stretch(*materials[mat], sigma0.full(), D < 3, mode == Mode::plane_stress);
-        if (!stretch)
-          throw InputError(body.where.file, body.where.line, fmt::format("body[{}].shape.points.file", b),
-                           fmt::format("initial stresses that material '{}' can carry (a stretch F0 with "
-                                       "tau(F0) = det(F0) sigma0)",
-                                       body.material),
-                           fmt::format("particle {} of '{}' (xx, yy, zz, yz, xz, xy = {}): no such stretch found",
-                                       row + 1, points->file, fmt::join(points->stress[row], ", ")));
-      }
+      const std::optional<Mat3> stretch = stretch_of(row);  // (before the selection: refused alike)
       const Vec<D> x = displacement ? Vec<D>(X + (*displacement)(X, X, 0.0)) : X;
-      if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x, replicated)) return;
+      if (select && !(*select)(id, static_cast<std::int32_t>(b), X, x, in_share)) return;
       Vec<D> v0 = velocity ? (*velocity)(X, X, 0.0) : Vec<D>::Zero();
       Vec<D> domain = lp;  // a point file's particle: a cube (square) of its own volume (area)
       if (points) {
@@ -324,10 +328,37 @@ void create_particles(const Config& config, const Grid<D>& grid,
         particles.deformation_gradient[p] = F;
       }
     };
+    // Candidate k (a lattice point, then the seeds): its reference position, volume and mass, and
+    // whether it is a particle (a lattice point inside the shape; every seed is).
+    auto candidate = [&](long long k, Vec<D>& X, double& particle_volume, double& particle_mass) {
+      if (k < n_lattice) {
+        X = lattice_point(k);
+        particle_volume = vol;
+        particle_mass = mass;
+        return inside<D>(body.shape, image.get(), line_of[b], X);
+      }
+      const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
+      X = s.X;
+      particle_volume = s.measure * thickness;
+      particle_mass = materials[mat]->density() * particle_volume;
+      return true;
+    };
+    // A walk shared by the ranks: the body's count and overlaps over every rank (each particle
+    // was tallied by one rank), and the ids that follow it.
+    auto sum_tallies = [&](const Comm& comm) {
+      std::vector<std::int64_t> sums(n_bodies + 1, 0);
+      sums[0] = static_cast<std::int64_t>(count_of[b]);
+      for (std::size_t a = 0; a < n_bodies; ++a) sums[a + 1] = static_cast<std::int64_t>(shared[b][a]);
+      comm.sum(sums.data(), static_cast<int>(sums.size()));
+      count_of[b] = static_cast<std::size_t>(sums[0]);
+      for (std::size_t a = 0; a < n_bodies; ++a) shared[b][a] = static_cast<std::size_t>(sums[a + 1]);
+      next_id += sums[0];
+    };
     // Per-rank generation of a plain lattice body (no seeds, no displacement): each rank tests
     // only its own lattice points (generation_share; docs/parallel.md).
     const bool plain = !radial && !points && !surface && !displacement;
-    if (share && share->comm && share->comm->parallel() && plain && total > 0) {
+    const bool ranks_share = share && share->comm && share->comm->parallel();
+    if (ranks_share && plain && total > 0) {
       const Comm& comm = *share->comm;
       // The inside lattice points this rank tests (k, in sweep order) and their ids.
       std::vector<long long> mine;
@@ -393,29 +424,54 @@ void create_particles(const Config& config, const Grid<D>& grid,
       }
       for (std::size_t j = 0; j < mine.size(); ++j) emit(mine[j], lattice_point(mine[j]), id_of[j], vol, mass, false);
       if (margin > 0) continue;  // a selecting walk: no ids, counts or checks
-      // The body's count and overlaps over every rank (each point was tested by one rank).
-      std::vector<std::int64_t> sums(n_bodies + 1, 0);
-      sums[0] = static_cast<std::int64_t>(count_of[b]);
-      for (std::size_t a = 0; a < n_bodies; ++a) sums[a + 1] = static_cast<std::int64_t>(shared[b][a]);
-      comm.sum(sums.data(), static_cast<int>(sums.size()));
-      count_of[b] = static_cast<std::size_t>(sums[0]);
-      for (std::size_t a = 0; a < n_bodies; ++a) shared[b][a] = static_cast<std::size_t>(sums[a + 1]);
-      next_id += sums[0];
+      sum_tallies(comm);
+    } else if (ranks_share && margin == 0) {
+      // Any other body (point file or mesh elements, the radial arrangement, a displacement):
+      // rank r takes the r-th block of its candidates, in creation order, and stores every
+      // particle it makes wherever it lies (x = X + u(X) is known only here); the simulation
+      // sends them to their owners afterwards (Distribution::migrate). Ids: the counts of the
+      // blocks before this rank's.
+      const Comm& comm = *share->comm;
+      const long long n_candidates = n_lattice + static_cast<long long>(seeds.size());
+      const auto r = static_cast<long long>(comm.rank()), n = static_cast<long long>(comm.size());
+      struct Made {
+        long long k;
+        Vec<D> X;
+        double volume, mass;
+      };
+      std::vector<Made> made;
+      for (long long k = n_candidates * r / n; k < n_candidates * (r + 1) / n; ++k) {
+        Made m{k, Vec<D>::Zero(), 0.0, 0.0};
+        if (!candidate(k, m.X, m.volume, m.mass)) continue;
+        tally(m.X, m.volume);
+        made.push_back(m);
+      }
+      const std::int64_t first = next_id + comm.exclusive_prefix(static_cast<std::int64_t>(made.size()));
+      // An initial stress the material cannot carry is refused on every rank at the first such
+      // row of the body, as a serial run refuses it.
+      std::int64_t refused = std::numeric_limits<std::int64_t>::max();
+      for (std::size_t j = 0; j < made.size(); ++j) {
+        try {
+          emit(made[j].k, made[j].X, first + static_cast<std::int64_t>(j), made[j].volume, made[j].mass, true);
+        } catch (const InputError&) {
+          refused = made[j].k;
+          break;
+        }
+      }
+      refused = comm.min(refused);
+      if (refused != std::numeric_limits<std::int64_t>::max()) {
+        (void)stretch_of(static_cast<std::size_t>(refused - n_lattice));  // throws
+        throw std::logic_error("create_particles: a refused initial stress solved on another rank");
+      }
+      sum_tallies(comm);
     } else {
+      // The whole body: a serial run, or a selecting walk (margin > 0) over a body of the kind above.
       for (long long k = 0; k < n_lattice + static_cast<long long>(seeds.size()); ++k) {
         Vec<D> X;
-        double particle_volume = vol, particle_mass = mass;
-        if (k < n_lattice) {
-          X = lattice_point(k);
-          if (!inside<D>(body.shape, image.get(), line_of[b], X)) continue;
-        } else {
-          const auto& s = seeds[static_cast<std::size_t>(k - n_lattice)];
-          X = s.X;
-          particle_volume = s.measure * thickness;
-          particle_mass = materials[mat]->density() * particle_volume;
-        }
+        double particle_volume = 0.0, particle_mass = 0.0;
+        if (!candidate(k, X, particle_volume, particle_mass)) continue;
         tally(X, particle_volume);
-        emit(k, X, next_id++, particle_volume, particle_mass, true);
+        emit(k, X, next_id++, particle_volume, particle_mass, false);
       }
     }
     if (count_of[b] == 0) {

@@ -55,11 +55,12 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   if (comm.parallel()) {
     // Per-rank generation (docs/parallel.md): the ranks walk the bodies' particles twice. The
     // first time (the census) rank r runs the inside tests of the r-th block of lattice rows of
-    // each lattice body and records the cells of its particles (and of every size-th particle
-    // of the bodies all ranks generate whole): the histograms, summed over the ranks, are those
-    // of all particles. The domain is bisected by them, and the second time each rank tests and
-    // stores only the lattice points of its own box. With parallel.balance = "cost" each census
-    // entry weighs what a particle of its body's material costs.
+    // each lattice body (of the r-th block of the candidates of any other body) and records the
+    // cells of its particles: the histograms, summed over the ranks, are those of all particles.
+    // The domain is bisected by them, and the second time each rank tests and stores only the
+    // lattice points of its own box, and its block of the other bodies' particles, which then
+    // move to their owners. With parallel.balance = "cost" each census entry weighs what a
+    // particle of its body's material costs.
     distribution_ = Distribution<D>(comm, whole_);
     distribution_.set_material_weights(material_weights());
     std::vector<std::int64_t> body_weight;
@@ -70,12 +71,9 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
       body_weight.push_back(w);
     }
     const bool weighed = config_.parallel.balance == "cost";
-    const auto rank = static_cast<std::int64_t>(comm.rank()), ranks = static_cast<std::int64_t>(comm.size());
     std::vector<IVec<D>> census;
     std::vector<std::int64_t> census_weight;
-    const ParticleSelection<D> count = [&](std::int64_t id, std::int32_t body, const Vec<D>&, const Vec<D>& x,
-                                           bool replicated) {
-      if (replicated && id % ranks != rank) return false;
+    const ParticleSelection<D> count = [&](std::int64_t, std::int32_t body, const Vec<D>&, const Vec<D>& x, bool) {
       census.push_back(distribution_.cell_of(x));
       if (weighed) census_weight.push_back(body_weight[static_cast<std::size_t>(body)]);
       return false;
@@ -85,12 +83,11 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     distribution_.partition_cells(census, census_weight);
     std::vector<IVec<D>>().swap(census);
     std::vector<std::int64_t>().swap(census_weight);
-    const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x, bool) {
-      return distribution_.owner_of(x) == comm.rank();
-    };
+    const ParticleSelection<D> mine = [&](std::int64_t, std::int32_t, const Vec<D>&, const Vec<D>& x,
+                                          bool in_share) { return in_share || distribution_.owner_of(x) == comm.rank(); };
     const GenerationShare<D> own{&comm, &distribution_.decomposition()};
     create_particles<D>(config_, grid_, materials_, mode_, particles_, &mine, &own);
-    distribution_.adopt(particles_);
+    distribution_.place(particles_);  // (a share of a body off the lattice to the owners)
   } else {
     create_particles<D>(config_, grid_, materials_, mode_, particles_);
   }

@@ -351,22 +351,23 @@ class Simulation {
 
 /// Which generated particles a rank stores (per-rank generation, docs/parallel.md): called for
 /// every particle the bodies generate on this rank, in creation order, with its id (its number in
-/// a serial run), body, reference position X and position x, and whether every rank generates it
-/// (`replicated`: bodies generated whole on every rank) or only this one (a rank's share of a
-/// lattice body, GenerationShare); true stores it. The checks of the generation (empty bodies,
-/// overlaps) count over every rank, so they decide alike.
+/// a serial run), body, reference position X and position x, and whether it is this rank's share
+/// of a body that is not split by boxes (`in_share`: a body off the plain lattice, see
+/// GenerationShare; no other rank makes it, wherever it lies); true stores it. The checks of the
+/// generation (empty bodies, overlaps) count over every rank, so they decide alike.
 template <int D>
 using ParticleSelection =
-    std::function<bool(std::int64_t id, std::int32_t body, const Vec<D>& X, const Vec<D>& x, bool replicated)>;
+    std::function<bool(std::int64_t id, std::int32_t body, const Vec<D>& X, const Vec<D>& x, bool in_share)>;
 
 /// Per-rank generation: the ranks of `comm` split the lattice points of the plain lattice bodies
 /// (no point file or mesh elements, no radial arrangement, no WLS surface particles, no
 /// displacement), so that each runs the inside tests of only its own points. Without a
 /// decomposition (the census that decides it) rank r takes the r-th block of lattice rows;
-/// with one, the points in the cells of its box, widened by `margin` cells. Other bodies are
-/// generated whole on every rank. A margin makes neighbouring ranks test the same points: such a
-/// walk only selects (the ids it passes mean nothing) and skips the generation's checks, which a walk
-/// without a margin has made.
+/// with one, the points in the cells of its box, widened by `margin` cells. Of every other body
+/// rank r makes the r-th block of its candidates (lattice points, then seeds), in both walks
+/// (`in_share`). A margin makes neighbouring ranks test the same points: such a walk only
+/// selects (the ids it passes mean nothing), skips the generation's checks, which a walk without
+/// a margin has made, and walks the other bodies whole.
 template <int D>
 struct GenerationShare {
   const Comm* comm = nullptr;
