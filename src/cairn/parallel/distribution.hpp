@@ -112,21 +112,27 @@ class Distribution {
   [[nodiscard]] std::int64_t ghost_bytes_sent() const { return bytes_sent_; }
   /// Every local particle (owned and ghost) in increasing id: the serial order.
   [[nodiscard]] const std::vector<std::int32_t>& id_order() const { return id_order_; }
-  /// Owners send their current `values` (width entries per particle) to the ghosts' copies.
+  /// Owners send their current `values` (width entries per particle) to the ghosts' copies. Each
+  /// side knows the sizes (the ghosts a neighbour holds of this rank are its send list), so the
+  /// messages go in one round into buffers kept between calls.
   template <class T>
   void refresh(std::vector<T>& values, int width = 1) const {
     if (!active() || width == 0) return;
-    Comm::Buffers send(neighbours_.size());
-    for (std::size_t k = 0; k < neighbours_.size(); ++k) pack_values(values, width, send_list_[k], send[k]);
-    const Comm::Buffers recv = comm_.exchange(neighbours_, send);
-    for (const auto& b : send) bytes_sent_ += static_cast<std::int64_t>(b.size());
+    const std::size_t row = static_cast<std::size_t>(width);
+    refresh_send_.resize(neighbours_.size());
+    refresh_recv_.resize(neighbours_.size());
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      refresh_send_[k].clear();
+      pack_values(values, width, send_list_[k], refresh_send_[k]);
+      refresh_recv_[k].resize(ghost_slot_[k].size() * row * sizeof(T));
+      bytes_sent_ += static_cast<std::int64_t>(refresh_send_[k].size());
+    }
+    comm_.exchange_sized(neighbours_, refresh_send_, refresh_recv_);
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      const std::vector<char>& in = refresh_recv_[k];
       std::size_t offset = 0;
-      const std::size_t row = static_cast<std::size_t>(width);
-      if (recv[k].size() != ghost_slot_[k].size() * row * sizeof(T))
-        throw std::runtime_error("ghost refresh: unexpected message size");
       for (std::int32_t slot : ghost_slot_[k]) {
-        std::memcpy(values.data() + static_cast<std::size_t>(slot) * row, recv[k].data() + offset, row * sizeof(T));
+        std::memcpy(values.data() + static_cast<std::size_t>(slot) * row, in.data() + offset, row * sizeof(T));
         offset += row * sizeof(T);
       }
     }
@@ -137,6 +143,7 @@ class Distribution {
   void census(const Particles<D>& particles, std::vector<IVec<D>>& cells, std::vector<std::int64_t>& weights) const;
   /// migrate(), or with `generated` place(): owners by owner_of, arrivals not counted.
   std::size_t send_to_owners(Particles<D>& particles, bool generated);
+  mutable Comm::Buffers refresh_send_, refresh_recv_;  ///< refresh(): per neighbour, kept
   Comm comm_ = Comm::serial();
   Grid<D> whole_;
   Decomposition<D> decomposition_;
