@@ -220,6 +220,14 @@ TEST(WlsConditions, TractionImpulseMovesAFreeBar) {
   ASSERT_NO_FATAL_FAILURE(check_free_bar<3>(0.425, false));
 }
 
+TEST(WlsConditions, TractionNeedsTheQuadratureGradient) {
+  // Eq. 29 as printed: the held bar grows node-scale noise until det F < 0 (docs/wls.md).
+  Config c = bar_config(2, 0.425, true);
+  c.tractions.push_back(end_traction(2, 1.0e3, "1"));
+  c.method.plugin.set("velocity_gradient", std::string("narrow"));
+  EXPECT_THROW(Simulation<2>{c}, std::invalid_argument);
+}
+
 TEST(WlsConditions, TractionOnARadialBodyIsRefused) {
   // Tractions load the faces of lattice particles; the rings of the radial arrangement have none.
   Config c = bar_config(2, 0.425, false);

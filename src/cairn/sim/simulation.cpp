@@ -258,6 +258,12 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
                                                 "periodic ") +
                                     "xyz"[a] + " axis (its stencils span 3 nodes; docs/wls.md)");
     wls::Options o = wls::options(config_.method);
+    // With Eq. 29 as printed a held bar under a traction grows node-scale noise until det F < 0
+    // (docs/wls.md, "Tractions"); the loads are balanced for the quadrature gradient.
+    if (!config_.tractions.empty() && !o.quadrature_gradient)
+      throw std::invalid_argument(config_.tractions.front().where.str() + ": [[traction]] under method.integration = "
+                                  "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default; "
+                                  "docs/wls.md)");
     // A symmetry face is a mirror plane of the body when the body reaches it at the start
     // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
     for (int f = 0; f < 2 * D; ++f) {
