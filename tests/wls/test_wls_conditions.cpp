@@ -129,16 +129,18 @@ HeldBar held_bar(double L, double lo, double hi, double transits) {
 }
 
 TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStress) {
-  // docs/wls.md, "Tractions": the loaded face inside a cell (x = 0.425) and on a node line
-  // (x = 0.45), the lateral faces inside cells and on node lines.
+  // docs/wls.md, "Tractions": the loaded face inside a cell (x = 0.425), on a node line
+  // (x = 0.45) and a fiftieth of a cell on either side of it (slivers of cut cells), the lateral
+  // faces inside cells and on node lines.
   struct Placement {
     double L, lo, hi;
   };
   for (const Placement& at : {Placement{0.425, 0.275, 0.525}, Placement{0.45, 0.275, 0.525},
-                              Placement{0.45, 0.25, 0.55}, Placement{0.425, 0.25, 0.55}}) {
+                              Placement{0.45, 0.25, 0.55}, Placement{0.425, 0.25, 0.55},
+                              Placement{0.449, 0.275, 0.525}, Placement{0.451, 0.275, 0.525}}) {
     const HeldBar r = held_bar<2>(at.L, at.lo, at.hi, 10.0);
     EXPECT_NEAR(r.mean, 1.0, 0.02) << at.L << " " << at.lo;
-    EXPECT_LT(r.oscillation, 0.03) << at.L << " " << at.lo;
+    EXPECT_LT(r.oscillation, 0.01) << at.L << " " << at.lo;  // (the ramp leaves the continuum at rest)
   }
 }
 
@@ -150,7 +152,7 @@ TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStress3D) {
     const HeldBar r = held_bar<3>(at.L, at.lo, at.hi, 10.0);
     EXPECT_NEAR(r.mean * r.section, 1.0, 0.02) << at.L << " " << at.lo;  // the force T A
     EXPECT_LT(r.section, 1.0);
-    EXPECT_LT(r.oscillation, 0.03) << at.L << " " << at.lo;
+    EXPECT_LT(r.oscillation, 0.02) << at.L << " " << at.lo;
   }
 }
 
