@@ -36,7 +36,9 @@ Tractions<D>::Tractions(const Config& config, const Grid<D>& grid, const Particl
   // Occupied lattice sites per body.
   std::vector<std::unordered_set<std::int64_t>> occupied(config.bodies.size());
   for (std::size_t p = 0; p < particles.n(); ++p)
-    occupied[particles.body[p]].insert(lattice_site(particles.reference_position[p], grid.origin(), particles.size0[p]));
+    if (particles.volume0[p] > 0.0)  // (a zero-volume sample point, a WLS surface particle, occupies no site)
+      occupied[particles.body[p]].insert(
+          lattice_site(particles.reference_position[p], grid.origin(), particles.size0[p]));
   select(config, grid, particles, occupied, Comm::serial());
 }
 
@@ -68,6 +70,9 @@ void Tractions<D>::select(const Config& config, const Grid<D>& grid, const Parti
     const bool has_box = !tc.box_min.empty();
     for (std::size_t p = 0; p < particles.n(); ++p) {
       if (body >= 0 && particles.body[p] != body) continue;
+      // A particle without volume has no faces: the surface particles of WLS (seed 001 Eq. 13,
+      // wls/arrangement.hpp), sample points on the surface between lattice sites.
+      if (!(particles.volume0[p] > 0.0)) continue;
       const Vec<D>& X = particles.reference_position[p];
       const Vec<D>& l0 = particles.size0[p];
       for (int a = 0; a < D; ++a)
@@ -136,36 +141,13 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
                               double t, std::vector<Vec<D>>& force,
                               const std::vector<std::int32_t>* field_offset) {
   if (loads_.empty()) return;
-  for (auto& load : loads_) load.total.setZero();
-  double factor = 0.0;
-  std::int32_t factor_of = -1;
-  for (std::size_t q = 0; q < faces_.size(); ++q) {
-    const Face& f = faces_[q];
-    if (f.load != factor_of) {  // faces of one load are contiguous in faces_
-      factor_of = f.load;
-      factor = loads_[f.load].factor(t);
-    }
-    const auto p = static_cast<std::size_t>(f.particle);
-    const Mat3& F = particles.deformation_gradient[p];
-    // Half-edge matrix R of the particle domain: its columns are the half edges.
-    Eigen::Matrix<double, D, D> R = (0.5 * particles.size0[p]).asDiagonal();
-    if (domain_ == ParticleDomain::convected) {
-      R = F.template topLeftCorner<D, D>() * R;
-    } else if (domain_ == ParticleDomain::stretched) {
-      for (int a = 0; a < D; ++a) R(a, a) *= std::abs(F(a, a));
-    }
-    // Face area: the face spans the half edges R e_b, b != axis.
-    double area = thickness_;
-    if constexpr (D == 2) {
-      area = 2.0 * R.col(1 - f.axis).norm() * thickness_;
-    } else if constexpr (D == 3) {
-      area = (2.0 * R.col((f.axis + 1) % 3)).cross(2.0 * R.col((f.axis + 2) % 3)).norm();
-    }
-    points_.position[q] = particles.position[p] + static_cast<double>(f.sign) * R.col(f.axis);
-    points_.deformation_gradient[q] = F;
-    point_force_[q] = (factor * area) * loads_[f.load].traction;
-    if (f.owned) loads_[f.load].total += point_force_[q];
-  }
+  std::size_t q = 0;  // (for_each_face visits the faces in order)
+  for_each_face(particles, t, [&](std::int32_t, const Vec<D>& centre, const Vec<D>&, const Vec<D>& face_force) {
+    points_.position[q] = centre;
+    points_.deformation_gradient[q] = particles.deformation_gradient[static_cast<std::size_t>(faces_[q].particle)];
+    point_force_[q] = face_force;
+    ++q;
+  });
 
   try {
     shape.build(grid, points_, cache_);
@@ -179,6 +161,58 @@ void Tractions<D>::add_forces(const Grid<D>& grid, const Particles<D>& particles
   for (std::size_t k = 0; k < point_force_.size(); ++k) {
     const std::int32_t off = field_offset ? (*field_offset)[static_cast<std::size_t>(faces_[k].particle)] : 0;
     for_each_entry(cache_, k, [&](std::int32_t node, double S, const Vec<D>&) { force[node + off] += S * point_force_[k]; });
+  }
+}
+
+template <int D>
+typename Tractions<D>::FaceGeometry Tractions<D>::face_geometry(const Particles<D>& particles, std::size_t q) const {
+  const Face& f = faces_[q];
+  const auto p = static_cast<std::size_t>(f.particle);
+  const Mat3& F = particles.deformation_gradient[p];
+  // Half-edge matrix R of the particle domain: its columns are the half edges.
+  Eigen::Matrix<double, D, D> R = (0.5 * particles.size0[p]).asDiagonal();
+  if (domain_ == ParticleDomain::convected) {
+    R = F.template topLeftCorner<D, D>() * R;
+  } else if (domain_ == ParticleDomain::stretched) {
+    for (int a = 0; a < D; ++a) R(a, a) *= std::abs(F(a, a));
+  }
+  // Face area: the face spans the half edges R e_b, b != axis; its normal points away from the
+  // particle centre (along sign R e_axis).
+  FaceGeometry g;
+  const Vec<D> out = static_cast<double>(f.sign) * R.col(f.axis);
+  g.centre = particles.position[p] + out;
+  if constexpr (D == 1) {
+    g.area = thickness_;
+    g.normal_area = Vec<D>(out[0] > 0.0 ? thickness_ : -thickness_);
+  } else if constexpr (D == 2) {
+    const Vec<2> t = 2.0 * R.col(1 - f.axis);
+    g.area = t.norm() * thickness_;
+    g.normal_area = Vec<2>(t[1], -t[0]) * thickness_;
+  } else {
+    g.normal_area = (2.0 * R.col((f.axis + 1) % 3)).cross(2.0 * R.col((f.axis + 2) % 3));
+    g.area = g.normal_area.norm();
+  }
+  if (g.normal_area.dot(out) < 0.0) g.normal_area = -g.normal_area;
+  return g;
+}
+
+template <int D>
+void Tractions<D>::for_each_face(
+    const Particles<D>& particles, double t,
+    const std::function<void(std::int32_t, const Vec<D>&, const Vec<D>&, const Vec<D>&)>& fn) {
+  for (auto& load : loads_) load.total.setZero();
+  double factor = 0.0;
+  std::int32_t factor_of = -1;
+  for (std::size_t q = 0; q < faces_.size(); ++q) {
+    const Face& f = faces_[q];
+    if (f.load != factor_of) {  // faces of one load are contiguous in faces_
+      factor_of = f.load;
+      factor = loads_[f.load].factor(t);
+    }
+    const FaceGeometry g = face_geometry(particles, q);
+    const Vec<D> force = (factor * g.area) * loads_[f.load].traction;
+    if (f.owned) loads_[f.load].total += force;
+    fn(2 * D * f.load + 2 * f.axis + (f.sign > 0 ? 1 : 0), g.centre, g.normal_area, force);
   }
 }
 

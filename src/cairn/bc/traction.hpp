@@ -38,6 +38,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <unordered_set>
 #include <vector>
@@ -84,6 +85,13 @@ class Tractions {
   void add_forces(const Grid<D>& grid, const Particles<D>& particles, const ShapeFamily<D>& shape,
                   double t, std::vector<Vec<D>>& force,
                   const std::vector<std::int32_t>* field_offset = nullptr);
+  /// Each loaded face at time t in the current configuration, for a method that integrates the
+  /// loads itself (method.integration = "wls", docs/wls.md): fn(group, centre, outward normal
+  /// times area, force T(t) A_s), group = 2 D k + 2 axis + (0 min, 1 max side) for traction k
+  /// (n_loads() tractions). The faces deform as in add_forces; the totals follow them.
+  void for_each_face(const Particles<D>& particles, double t,
+                     const std::function<void(std::int32_t, const Vec<D>&, const Vec<D>&, const Vec<D>&)>& fn);
+  [[nodiscard]] std::size_t n_loads() const { return loads_.size(); }
   /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v),
   /// over the faces of owned particles, summed exactly (the caller adds the ranks).
   [[nodiscard]] ExactSum power(const std::vector<Vec<D>>& v,
@@ -112,6 +120,13 @@ class Tractions {
     std::int64_t id = 0;  ///< the particle's id
     bool owned = true;    ///< false: a ghost copy's face (forces only, no totals)
   };
+  /// Centre, outward normal times area and area of face q of the current configuration.
+  struct FaceGeometry {
+    Vec<D> centre;
+    Vec<D> normal_area;
+    double area;
+  };
+  [[nodiscard]] FaceGeometry face_geometry(const Particles<D>& particles, std::size_t q) const;
   struct Load {
     Vec<D> traction = Vec<D>::Zero();
     TimeFunction factor;

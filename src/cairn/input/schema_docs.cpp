@@ -107,8 +107,9 @@ const std::vector<SectionDoc>& section_docs() {
       {"traction", "[[traction]]",
        "A traction on the exposed faces of a body's particles, added to the grid forces (seed 000 "
        "Sec. 2.4): T(t) = traction * scale(t) * table(t), spread with the grid functions over each "
-       "face; the face area follows the deformation with cpdi, b2cpdi and cpgimp. Faces are "
-       "selected by side, by box or both. See docs/boundary-conditions.md.",
+       "face; the face area follows the deformation with cpdi, b2cpdi and cpgimp (and under "
+       "method.integration = \"wls\", which spreads the force over its cut-cell surface, "
+       "docs/wls.md). Faces are selected by side, by box or both. See docs/boundary-conditions.md.",
        "[[traction]]\n"
        "body = \"bar\"\n"
        "side = \"x_min\"\n"

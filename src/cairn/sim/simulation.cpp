@@ -215,7 +215,10 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     create_particles<D>(config_, grid_, materials_, mode_, none, &sites, &near);
     tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain(), occupied, comm);
   } else {
-    tractions_ = Tractions<D>(config_, grid_, particles_, shape_->particle_domain());
+    // WLS: the faces are convected by F, as the cut cells follow the deformed body.
+    tractions_ = Tractions<D>(config_, grid_, particles_,
+                              config_.method.integration == "wls" ? ParticleDomain::convected
+                                                                  : shape_->particle_domain());
   }
   if (!config_.tractions.empty())
     on(StepPoint::after_forces, [this](double dt) {
@@ -232,11 +235,18 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     const char* unsupported = D == 1                          ? "a 1D simulation"
                               : config_.contact.enabled()     ? "[contact]"
                               : config_.thermal.conduction    ? "[thermal] conduction"
-                              : !config_.tractions.empty()    ? "[[traction]]"
                                                               : nullptr;
     if (unsupported)
       throw std::invalid_argument(std::string("method.integration = \"wls\" does not support ") + unsupported +
                                   " (docs/wls.md)");
+    // Tractions load the faces of lattice particles (bc/traction.hpp); the rings of the radial
+    // arrangement have none.
+    for (const auto& tc : config_.tractions)
+      for (const auto& b : config_.bodies)
+        if ((tc.body.empty() || tc.body == b.name) && b.arrangement == "radial")
+          throw std::invalid_argument(tc.where.str() + ": traction '" + tc.name + "' loads body '" + b.name +
+                                      "', whose arrangement is \"radial\": tractions load the faces of lattice "
+                                      "particles (arrangement = \"cartesian\"; docs/wls.md)");
     // Periodic axes wrap the stencils, fits, neighbour averages and cut cells; the 3 nodes of a
     // stencil along the axis must be distinct nodes.
     for (int a = 0; a < D; ++a)
@@ -245,6 +255,12 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
                                                 "periodic ") +
                                     "xyz"[a] + " axis (its stencils span 3 nodes; docs/wls.md)");
     wls::Options o = wls::options(config_.method);
+    // With Eq. 29 as printed a held bar under a traction grows node-scale noise until det F < 0
+    // (docs/wls.md, "Tractions"); the loads are balanced for the quadrature gradient.
+    if (!config_.tractions.empty() && !o.quadrature_gradient)
+      throw std::invalid_argument(config_.tractions.front().where.str() + ": [[traction]] under method.integration = "
+                                  "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default; "
+                                  "docs/wls.md)");
     // A symmetry face is a mirror plane of the body when the body reaches it at the start
     // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
     for (int f = 0; f < 2 * D; ++f) {

@@ -133,6 +133,22 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     return sim_.body_force_.empty() ? nullptr : &sim_.body_acceleration_;
   }
   std::vector<Vec<D>>* node_body_forces() override { return &sim_.node_body_force_; }
+  bool surface_loads(double dt, wls::SurfaceLoads<D>& loads) override {
+    if (sim_.tractions_.empty()) return false;
+    // The tractions' faces convected by F (bc/traction.hpp); the integrator spreads their forces
+    // over the cut-cell surface (wls/integrator.cpp, spread_surface_loads).
+    loads.reset(2 * D * sim_.tractions_.n_loads());
+    sim_.tractions_.for_each_face(sim_.particles_, sim_.time_ + 0.5 * dt,
+                                  [&](std::int32_t g, const Vec<D>& centre, const Vec<D>& normal_area,
+                                      const Vec<D>& force) {
+                                    loads.centre.push_back(centre);
+                                    loads.face_force.push_back(force);
+                                    loads.group.push_back(g);
+                                    loads.force[g] += force;
+                                    loads.normal[g] += normal_area;
+                                  });
+    return true;
+  }
   void prepare_conditions(double dt) override {
     sim_.velocity_conditions_.prepare(sim_.grid_, sim_.nodes_, sim_.small_mass_, sim_.time_, dt);
   }
@@ -439,7 +455,14 @@ void Simulation<D>::update_grid(double dt) {
   // summed exactly over the nodes (traction faces) each rank owns and over the ranks.
   const bool has_body_force = !body_force_.empty();
   std::array<ExactSum, 3> work;
-  if (!tractions_.empty()) {
+  if (!tractions_.empty() && wls_) {
+    // (WLS: the node forces of the tractions are the integrator's, wls/integrator.cpp)
+    const auto& f = wls_->surface_force();
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      work[0].add(f[i].dot(nodes_.velocity[i]));
+      work[1].add(f[i].dot(nodes_.velocity_new[i]));
+    }
+  } else if (!tractions_.empty()) {
     work[0] = tractions_.power(nodes_.velocity, contact_ ? &field_offset_ : nullptr);
     work[1] = tractions_.power(nodes_.velocity_new, contact_ ? &field_offset_ : nullptr);
   }

@@ -88,6 +88,29 @@ void corner_shape(int corner, const Vec<D>& xi, const Vec<D>& inv_h, double& S, 
   }
 }
 
+/// fn(node, S, G) for the corners of the cell holding x that the grid holds: the narrow shape of
+/// seed 001 Eq. 5-6 at x.
+template <int D, class Fn>
+void for_each_corner_at(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& inv_h, Fn&& fn) {
+  const Vec<D> u = grid.to_cell_units(x);
+  IVec<D> cell;
+  Vec<D> local;
+  for (int a = 0; a < D; ++a) {
+    cell[a] = static_cast<int>(std::floor(u[a]));
+    local[a] = u[a] - cell[a];
+  }
+  for (int corner = 0; corner < (1 << D); ++corner) {
+    IVec<D> j = cell;
+    for (int a = 0; a < D; ++a) j[a] += (corner >> a) & 1;
+    const std::int32_t node = grid.node_index(j);
+    if (node < 0) continue;
+    double S;
+    Vec<D> G;
+    corner_shape<D>(corner, local, inv_h, S, G);
+    fn(node, S, G);
+  }
+}
+
 }  // namespace
 
 template <int D>
@@ -182,7 +205,7 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
 template <int D>
 void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
                             const std::vector<double>& density0, const std::vector<Vec<D>>* body_acceleration,
-                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force) {
+                            NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force, bool surface_loads) {
   const auto n = static_cast<std::int64_t>(particles.n());
   const bool body_force = body_acceleration != nullptr;
   const int n_used = body_force ? n_fields : n_fields - D;
@@ -283,7 +306,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
-  integrate(grid, body_force, nodes, node_body_force);
+  integrate(grid, body_force, nodes, node_body_force, surface_loads);
 }
 
 template <int D>
@@ -403,24 +426,8 @@ void Integrator<D>::refine_distance(const Grid<D>& grid) {
     if (surface_weight_[i] <= 0.0) return;
     const Vec<D>& xs = surface_sum_[i];
     // Normal: gradient of the flag field at x_surf (Eq. 16), from the corners of its cell.
-    const Vec<D> u = grid.to_cell_units(xs);
-    IVec<D> cell;
-    Vec<D> local;
-    for (int a = 0; a < D; ++a) {
-      cell[a] = static_cast<int>(std::floor(u[a]));
-      local[a] = u[a] - cell[a];
-    }
     Vec<D> normal = Vec<D>::Zero();
-    for (int corner = 0; corner < (1 << D); ++corner) {
-      IVec<D> j = cell;
-      for (int a = 0; a < D; ++a) j[a] += (corner >> a) & 1;
-      const std::int32_t node = grid.node_index(j);
-      if (node < 0) continue;
-      double S;
-      Vec<D> G;
-      corner_shape<D>(corner, local, inv_h, S, G);
-      normal += G * beta_[node];
-    }
+    for_each_corner_at(grid, xs, inv_h, [&](std::int32_t node, double, const Vec<D>& G) { normal += G * beta_[node]; });
     const Vec<D> dv = xs - grid.node_position(i);
     const double along = dv.dot(normal);
     if (options_.projected_distance) {
@@ -566,17 +573,24 @@ void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i,
 
 template <int D>
 void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
-                              std::vector<Vec<D>>* node_body_force) {
+                              std::vector<Vec<D>>* node_body_force, bool surface_loads) {
   const std::int32_t n_nodes = grid.n_nodes();
+  if (surface_loads && surface_vector_.size() != static_cast<std::size_t>(n_nodes)) {
+    surface_vector_.assign(n_nodes, Vec<D>::Zero());
+    surface_force_.assign(n_nodes, Vec<D>::Zero());
+    load_stamp_.assign(n_nodes, -1);
+  }
   // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
   for_each_node(n_nodes, [&](std::int32_t i) {
     double m = 0.0;
-    Vec<D> fe = Vec<D>::Zero(), fi = Vec<D>::Zero();
+    Vec<D> fe = Vec<D>::Zero(), fi = Vec<D>::Zero(), a = Vec<D>::Zero();
     for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>& G) {
       m += S * q.density * q.volume;         // Eq. 22
       fe += S * q.volume * q.force_density;  // Eq. 23
       fi -= q.volume * (q.stress * G);       // Eq. 24 (with sigma_q; Eq. 3's sign)
+      if (surface_loads) a += q.volume * G;  // Eq. 24's rule for a unit stress: the surface vector
     });
+    if (surface_loads) surface_vector_[i] = a;
     nodes.mass[i] = m;
     nodes.momentum[i] = m * velocity_[i];
     internal_force_[i] = fi;
@@ -584,6 +598,12 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
     if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
   });
+  if (surface_loads) {
+    // The loads join the internal force: they are the boundary term of the weak form whose volume
+    // term is Eq. 24, and a spurious node takes its neighbours' mean of both (docs/wls.md).
+    spread_surface_loads(grid);
+    for_each_node(n_nodes, [&](std::int32_t i) { internal_force_[i] += surface_force_[i]; });
+  }
   // Sec. 3.5 / 4.5: the internal force of a spurious node is the mean over its 3^D - 1
   // neighbours that are well conditioned and carry mass (per unit mass by default, docs/wls.md).
   for_each_node(n_nodes, [&](std::int32_t i) {
@@ -601,6 +621,58 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     }
     nodes.force[i] += fi;
   });
+}
+
+template <int D>
+void Integrator<D>::spread_surface_loads(const Grid<D>& grid) {
+  // A traction is defined on the particles' faces (seed 000 Sec. 2.4), but the body the method
+  // integrates is the union of the cut-cell regions (Eq. 18), and Eq. 24's internal force of a
+  // uniform stress sigma is -sigma a_i with a_i = sum_q G_iq V_q, which in 2D is exactly the
+  // integral of S_i n over the regions' surface (the patch test
+  // UniformStressForceIsTheSurfaceTractionIntegral; inner cell faces cancel). A group's force
+  // F (sum of T A_s over its faces, outward direction n) is spread over the nodes near its faces
+  // in proportion to max(0, n . a_i), the area of the cut-cell surface facing n that each node
+  // carries: then the loaded body's stress T (x) n balances the load node by node, also at the
+  // nodes that see only a sliver of a cut cell, whose mass is O(eps^2) (Eq. 22) while their
+  // forces are O(eps). Not in seed 001, which defines no tractions (docs/wls.md).
+  const auto n_groups = static_cast<std::int32_t>(loads_.force.size());
+  std::fill(surface_force_.begin(), surface_force_.end(), Vec<D>::Zero());
+  std::fill(load_stamp_.begin(), load_stamp_.end(), -1);
+  const Vec<D> inv_h = h_.cwiseInverse();
+  for (std::int32_t g = 0; g < n_groups; ++g) {
+    const double area = loads_.normal[g].norm();
+    if (!(area > 0.0)) continue;
+    const Vec<D> n = loads_.normal[g] / area;
+    // The nodes of the 3^D blocks around the nearest nodes of the group's face centres.
+    load_nodes_.clear();
+    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
+      if (loads_.group[f] != g) continue;
+      const Vec<D> x = grid.to_cell_units(loads_.centre[f]);
+      for (int s = 0; s < pow3(D); ++s) {
+        IVec<D> j;
+        for (int a = 0, k = s; a < D; ++a, k /= 3) j[a] = static_cast<int>(std::lround(x[a])) + k % 3 - 1;
+        const std::int32_t i = grid.node_index(j);
+        if (i < 0 || load_stamp_[i] == g) continue;
+        load_stamp_[i] = g;
+        load_nodes_.push_back(i);
+      }
+    }
+    double sum = 0.0;
+    for (std::int32_t i : load_nodes_) sum += std::max(0.0, n.dot(surface_vector_[i]));
+    if (sum > 1e-9 * area) {
+      for (std::int32_t i : load_nodes_)
+        surface_force_[i] += (std::max(0.0, n.dot(surface_vector_[i])) / sum) * loads_.force[g];
+      continue;
+    }
+    // No cut-cell surface faces the group (it lies outside every region): each face's force by
+    // the narrow shape S of Eq. 5 at its centre, as MPM's linear family would.
+    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
+      if (loads_.group[f] != g) continue;
+      for_each_corner_at(grid, loads_.centre[f], inv_h, [&](std::int32_t i, double S, const Vec<D>&) {
+        surface_force_[i] += S * loads_.face_force[f];
+      });
+    }
+  }
 }
 
 template <int D>

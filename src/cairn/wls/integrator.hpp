@@ -70,6 +70,27 @@ struct Options {
   bool filter_acceleration = false;
 };
 
+/// Loads on parts of the body's surface (tractions on particle faces, bc/traction.hpp), which
+/// the integrator spreads over the nodes consistently with its internal force (docs/wls.md,
+/// "Tractions"). A group is one loaded part with one outward direction: the faces of one
+/// traction with one normal axis and side.
+template <int D>
+struct SurfaceLoads {
+  std::vector<Vec<D>> centre;       ///< current centre of each loaded face
+  std::vector<Vec<D>> face_force;   ///< its force T A_s
+  std::vector<std::int32_t> group;  ///< its group
+  std::vector<Vec<D>> force;        ///< per group: the sum of its faces' forces
+  std::vector<Vec<D>> normal;       ///< per group: the sum of its faces' outward normals times area
+  /// Empty faces and n_groups zero groups (keeps the storage).
+  void reset(std::size_t n_groups) {
+    centre.clear();
+    face_force.clear();
+    group.clear();
+    force.assign(n_groups, Vec<D>::Zero());
+    normal.assign(n_groups, Vec<D>::Zero());
+  }
+};
+
 /// The Options the [method] keys of the WLS method give (wls/options.cpp, where they are
 /// declared); mirror planes and thickness are the engine's to set.
 Options options(const MethodConfig& method);
@@ -100,7 +121,11 @@ class Integrator {
   /// reference density of material m; `body_acceleration` (b_p, or null) the body force.
   void collect(const Grid<D>& grid, const Particles<D>& particles, const std::vector<double>& density0,
                const std::vector<Vec<D>>* body_acceleration, NodeField<D>& nodes,
-               std::vector<Vec<D>>* node_body_force);
+               std::vector<Vec<D>>* node_body_force, bool surface_loads = false);
+  /// The loads the engine fills before collect(..., surface_loads = true).
+  [[nodiscard]] SurfaceLoads<D>& surface_loads() { return loads_; }
+  /// Node forces of the surface loads of the last collect (zero without loads).
+  [[nodiscard]] const std::vector<Vec<D>>& surface_force() const { return surface_force_; }
 
   /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
   /// x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
@@ -147,7 +172,9 @@ class Integrator {
   void extrapolate_spurious_velocity(const Grid<D>& grid);
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
-  void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force);
+  void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force,
+                 bool surface_loads);
+  void spread_surface_loads(const Grid<D>& grid);
   /// fn(region index, region, S_iq, G_iq) for every region in the cells node i is a corner of.
   template <class Fn>
   void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;
@@ -180,6 +207,11 @@ class Integrator {
   std::vector<std::uint8_t> live_;     ///< a particle reached the node at its last fit
   std::vector<double> distance_;
   std::vector<Vec<D>> internal_force_;
+  SurfaceLoads<D> loads_;
+  std::vector<Vec<D>> surface_vector_;  ///< a_i = sum_q G_iq V_q (the surface integral of S_i n)
+  std::vector<Vec<D>> surface_force_;   ///< node forces of the surface loads
+  std::vector<std::int32_t> load_stamp_;  ///< scratch of spread_surface_loads
+  std::vector<std::int32_t> load_nodes_;
   long long n_spurious_ = 0;
   // cells
   std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_

@@ -9,7 +9,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
   engine.lap(0);
   // Sec. 4.1-4.5: node mass, least-squares velocity (as m v) and forces.
   const std::vector<Vec<D>>* body = engine.body_accelerations();
-  wls.collect(grid, particles, density0, body, nodes, body ? engine.node_body_forces() : nullptr);
+  const bool loads = engine.surface_loads(dt, wls.surface_loads());  // tractions at t + dt/2
+  wls.collect(grid, particles, density0, body, nodes, body ? engine.node_body_forces() : nullptr, loads);
   engine.prepare_conditions(dt);
   engine.lap(1);
   engine.update_grid(dt);  // Eq. 25-26 with the conditions; half the first acceleration (Sec. 4.7)

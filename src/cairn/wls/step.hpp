@@ -22,6 +22,8 @@ class EngineStages {
   /// S^T M b part of the node forces goes.
   virtual const std::vector<Vec<D>>* body_accelerations() = 0;
   virtual std::vector<Vec<D>>* node_body_forces() = 0;
+  /// Fill `loads` with the surface loads (tractions) at t + dt/2; false: none.
+  virtual bool surface_loads(double dt, SurfaceLoads<D>& loads) = 0;
   /// The velocity conditions of this step, from the collected node masses.
   virtual void prepare_conditions(double dt) = 0;
   /// Eq. 25-26: v+ = v + a dt with the velocity conditions (half the first acceleration, Sec. 4.7).
