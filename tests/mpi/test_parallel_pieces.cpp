@@ -373,29 +373,5 @@ TEST(NodeHalo, SharedNodesAreTheSameListFromBothSidesAndHoldEveryNodeBothCanReac
   EXPECT_FALSE(NodeHalo<2>::shared_nodes(left, right, open, 3).empty());  // nodes 7 and 8 both
 }
 
-// parallel.overlap's split (NodeHalo::reaches_shared): a cell is marked exactly when a stencil of
-// the given reach around it holds one of the nodes, across a periodic seam too.
-TEST(NodeHalo, CellsReachingMarkEveryCellWhoseStencilHoldsANode) {
-  const Grid<2> whole(Vec<2>(0.0, 0.0), IVec<2>(12, 6), Vec<2>(1.0, 1.0), 2, {true, false});
-  const Grid<2> window = box_window(whole, CellBox<2>{IVec<2>(0, 0), IVec<2>(5, 6)}, 2);
-  std::vector<std::int32_t> nodes;  // a few scattered nodes, one beyond the seam
-  for (const IVec<2>& j : {IVec<2>(5, 3), IVec<2>(-2, 0), IVec<2>(3, -2), IVec<2>(6, 8)})
-    nodes.push_back(window.node_index(j));
-  for (const int reach : {0, 1, 2}) {
-    const std::vector<std::uint8_t> near = NodeHalo<2>::cells_reaching(window, nodes, reach);
-    ASSERT_EQ(near.size(), static_cast<std::size_t>(window.n_nodes()));
-    for (std::int32_t c = 0; c < window.n_nodes(); ++c) {
-      const IVec<2> cell = window.multi_index(c);
-      bool holds = false;
-      for (int dx = -reach; dx <= 1 + reach; ++dx)
-        for (int dy = -reach; dy <= 1 + reach; ++dy) {
-          const std::int32_t i = window.node_index(cell + IVec<2>(dx, dy));
-          holds |= i >= 0 && std::find(nodes.begin(), nodes.end(), i) != nodes.end();
-        }
-      EXPECT_EQ(near[static_cast<std::size_t>(c)] != 0, holds) << "reach " << reach << " cell " << cell.transpose();
-    }
-  }
-}
-
 }  // namespace
 }  // namespace cairn

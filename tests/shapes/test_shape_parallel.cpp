@@ -51,26 +51,17 @@ TEST(ShapeFamiliesInParallel, EveryFamilyIsBitIdenticalForAnyThreadCount) {
   omp_set_num_threads(omp_get_num_procs());
 }
 
-// 64 x 48 unit cells: 8 x 6 colouring blocks.
-Grid<2> colouring_grid() { return Grid<2>(Vec<2>(0.0, 0.0), IVec<2>(64, 48), Vec<2>(1.0, 1.0), 2, {false, false}); }
-
-// Particles at random places on `grid`, enough for the colouring's threaded sort.
-Particles<2> random_particles(const Grid<2>& grid, std::mt19937& rng) {
-  std::uniform_real_distribution<double> x(0.0, grid.n_cells()[0]), y(0.0, grid.n_cells()[1]);
-  Particles<2> particles;
-  particles.resize(3 * particle_loop_min + 5);
-  for (std::size_t p = 0; p < particles.n(); ++p) particles.position[p] = Vec<2>(x(rng), y(rng));
-  return particles;
-}
-
 // The colouring's binning and counting sort run in one team from particle_loop_min particles:
 // for 1, 2 and 3 threads they give the serial stable sort by block (storage order within a
 // block, or a distributed run's id order), the same block offsets and the same colour lists.
 TEST(ParticleAffinity, ColouringSortIsTheStableSortForAnyThreadCount) {
-  const Grid<2> grid = colouring_grid();
+  const Grid<2> grid(Vec<2>(0.0, 0.0), IVec<2>(64, 48), Vec<2>(1.0, 1.0), 2, {false, false});
+  Particles<2> particles;
   std::mt19937 rng(7);
-  const Particles<2> particles = random_particles(grid, rng);
-  const std::size_t n = particles.n();
+  std::uniform_real_distribution<double> x(0.0, 64.0), y(0.0, 48.0);
+  const std::size_t n = 3 * particle_loop_min + 5;
+  particles.resize(n);
+  for (std::size_t p = 0; p < n; ++p) particles.position[p] = Vec<2>(x(rng), y(rng));
   for (const bool by_id : {false, true}) {
     std::vector<std::int32_t> sequence(n);
     std::iota(sequence.begin(), sequence.end(), 0);
@@ -101,43 +92,6 @@ TEST(ParticleAffinity, ColouringSortIsTheStableSortForAnyThreadCount) {
             << p;
     }
   }
-  omp_set_num_threads(omp_get_num_procs());
-}
-
-// parallel.overlap's two-part scatter (split_blocks): each part visits the particles it should,
-// each once, block by block in the block's order, the same for 1, 2 and 3 threads.
-TEST(ParticleAffinity, SplitScatterVisitsEachParticleOnceInItsPart) {
-  const Grid<2> grid = colouring_grid();
-  std::mt19937 rng(11);
-  const Particles<2> particles = random_particles(grid, rng);
-  const std::size_t n = particles.n();
-  const auto first = [&](std::int32_t p) { return particles.position[p][0] > 50.0 || p % 7 == 0; };
-  std::vector<std::vector<std::int32_t>> orders;
-  for (const int threads : {1, 2, 3}) {
-    omp_set_num_threads(threads);
-    TransferCache<2> cache;
-    cache.reserve(n, 4);
-    colour_blocks(grid, particles, cache);
-    split_blocks(cache, first);
-    for (std::size_t b = 0; b + 1 < cache.block_begin.size(); ++b) {
-      std::vector<std::int32_t> expected;
-      for (const bool part : {true, false})
-        for (std::int32_t i = cache.block_begin[b]; i < cache.block_begin[b + 1]; ++i)
-          if (first(cache.order[i]) == part) expected.push_back(cache.order[i]);
-      ASSERT_TRUE(std::equal(expected.begin(), expected.end(), cache.split_order.begin() + cache.block_begin[b]));
-      ASSERT_EQ(cache.split_at[b] - cache.block_begin[b],
-                std::count_if(expected.begin(), expected.end(), first));
-    }
-    orders.push_back(cache.split_order);
-    std::vector<int> visits(n, 0);
-    for (const ScatterPart part : {ScatterPart::first, ScatterPart::second})
-      scatter(cache, [&](std::int32_t p, const auto&) {
-        ++visits[p];
-        ASSERT_EQ(first(p), part == ScatterPart::first) << p;
-      }, part);
-    ASSERT_EQ(std::count(visits.begin(), visits.end(), 1), static_cast<std::ptrdiff_t>(n));
-  }
-  for (const auto& order : orders) ASSERT_EQ(order, orders.front());
   omp_set_num_threads(omp_get_num_procs());
 }
 

@@ -58,9 +58,6 @@ struct ParallelConfig {
   /// What the bisection balances: count = particles per rank; cost = the particles' measured
   /// cost per step (their material model's, or the material's balance_cost).
   std::string balance = "count";
-  /// nodes: the particle-to-grid sums' exchange travels while the particles whose stencils
-  /// reach no shared node scatter (docs/parallel.md, "Node halo").
-  bool overlap = true;
 };
 
 struct GridConfig {

@@ -67,7 +67,6 @@ void Loader::read_parallel(const toml::table& root, Config& cfg) {
   r.reject_unknown_keys();
   cfg.parallel.halo = r.string("halo");
   cfg.parallel.balance = r.string("balance");
-  cfg.parallel.overlap = r.boolean("overlap");
 }
 
 void Loader::read_body_force(const toml::table& root, Config& cfg) {

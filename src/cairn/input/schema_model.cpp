@@ -113,14 +113,6 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "simulation.rebalance_threshold then measure the same. Unused on one rank.")
                 .by_default("\"count\"")
                 .choices([] { return std::vector<std::string>{"count", "cost"}; }));
-  k.push_back(Key("parallel", "overlap", T::boolean,
-                 "Runs on several MPI ranks with halo = nodes: each rank first scatters the "
-                 "particles whose stencils reach nodes it shares with a neighbour, sends those "
-                 "nodes' sums, and scatters the rest of its particles while the messages travel "
-                 "(docs/parallel.md, \"Node halo\"). The terms at a node are then added in another "
-                 "order: results differ from false by round-off, still the same bits run to run. "
-                 "Unused on one rank.")
-                .by_default("true"));
   k.push_back(Key("simulation", "max_estimated_steps", T::real,
                  "Refuse a run whose end_time / first time step exceeds this (a run that would "
                  "never end), naming the material that sets the step; 0 = no check. Not checked "

@@ -108,7 +108,6 @@ std::string config_to_toml(const Config& c) {
   o += "\n[parallel]\n";
   line("halo", toml_string(c.parallel.halo));
   line("balance", toml_string(c.parallel.balance));
-  line("overlap", c.parallel.overlap ? "true" : "false");
 
   if (!c.fem.enabled) {
     o += "\n[grid]\n";

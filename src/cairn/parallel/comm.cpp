@@ -100,46 +100,24 @@ Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers& 
 }
 
 void Comm::exchange_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv) const {
-  Pending pending;
-  start_sized(neighbours, send, recv, pending);
-  pending.wait();
-}
-
-void Comm::start_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv,
-                       Pending& pending) const {
-  pending.wait();
   const std::size_t k = neighbours.size();
   if (!parallel() || k == 0) return;
   constexpr int tag = 7103;
-  pending.received_.resize(k, MPI_REQUEST_NULL);
-  pending.sent_.resize(k, MPI_REQUEST_NULL);
+  std::vector<MPI_Request> requests;
+  requests.reserve(2 * k);
   for (std::size_t i = 0; i < k; ++i) {
-    if (!recv[i].empty())
+    if (!recv[i].empty()) {
+      requests.emplace_back();
       MPI_Irecv(recv[i].data(), checked_count(recv[i].size()), MPI_BYTE, neighbours[i], tag, MPI_COMM_WORLD,
-                &pending.received_[i]);
-    if (!send[i].empty())
+                &requests.back());
+    }
+    if (!send[i].empty()) {
+      requests.emplace_back();
       MPI_Isend(send[i].data(), checked_count(send[i].size()), MPI_BYTE, neighbours[i], tag, MPI_COMM_WORLD,
-                &pending.sent_[i]);
+                &requests.back());
+    }
   }
-}
-
-void Comm::Pending::wait_received() {
-  if (received_.empty()) return;
-  MPI_Waitall(static_cast<int>(received_.size()), received_.data(), MPI_STATUSES_IGNORE);
-  received_.clear();
-}
-
-void Comm::Pending::wait() {
-  wait_received();
-  if (sent_.empty()) return;
-  MPI_Waitall(static_cast<int>(sent_.size()), sent_.data(), MPI_STATUSES_IGNORE);
-  sent_.clear();
-}
-
-Comm::Pending::~Pending() {
-  int finalised = 0;
-  MPI_Finalized(&finalised);
-  if (!finalised) wait();
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
 }
 
 Comm::Buffers Comm::all_to_all(const Buffers& send) const {
@@ -217,10 +195,6 @@ Comm::Buffers Comm::exchange(const std::vector<int>& neighbours, const Buffers&)
   return Buffers(neighbours.size());
 }
 void Comm::exchange_sized(const std::vector<int>&, const Buffers&, Buffers&) const {}
-void Comm::start_sized(const std::vector<int>&, const Buffers&, Buffers&, Pending&) const {}
-void Comm::Pending::wait() {}
-void Comm::Pending::wait_received() {}
-Comm::Pending::~Pending() = default;
 Comm::Buffers Comm::all_to_all(const Buffers& send) const { return Buffers{send.at(0)}; }
 void Comm::abort(int code) const { std::exit(code); }
 MpiSession::MpiSession(int*, char***) {}

@@ -10,7 +10,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <utility>
 #include <vector>
 
 #ifdef CAIRN_HAVE_MPI
@@ -71,38 +70,6 @@ class Comm {
   /// The same with sizes both sides know: recv[k] arrives sized for what neighbours[k] sends
   /// (one round of messages, no size exchange).
   void exchange_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv) const;
-  /// An exchange_sized in flight (start_sized): recv stays untouched until wait_received() or
-  /// wait(), send until wait(). Destroying it waits for what is still in flight.
-  class Pending {
-   public:
-    Pending() = default;
-    Pending(Pending&&) = default;  // (the requests refer to buffers, which a move leaves in place)
-    Pending& operator=(Pending&& other) noexcept {
-      wait();
-#ifdef CAIRN_HAVE_MPI
-      received_ = std::move(other.received_);
-      sent_ = std::move(other.sent_);
-      other.received_.clear();
-      other.sent_.clear();
-#endif
-      return *this;
-    }
-    ~Pending();
-    /// Complete every message (recv then holds what the neighbours sent); a no-op when none.
-    void wait();
-    /// Complete the received messages only: the sends complete later (wait()), so that this
-    /// rank need not hear back from a neighbour that has not yet come to its own wait.
-    void wait_received();
-
-   private:
-    friend class Comm;
-#ifdef CAIRN_HAVE_MPI
-    std::vector<MPI_Request> received_, sent_;  ///< kept between exchanges (no allocation once sized)
-#endif
-  };
-  /// exchange_sized's first half: post the messages and return; pending.wait() completes them,
-  /// so that work on other data can run while they travel.
-  void start_sized(const std::vector<int>& neighbours, const Buffers& send, Buffers& recv, Pending& pending) const;
   /// Every rank to every rank: send[r] goes to rank r (size() buffers); returns recv[r] from r.
   [[nodiscard]] Buffers all_to_all(const Buffers& send) const;
 

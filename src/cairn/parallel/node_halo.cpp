@@ -23,7 +23,6 @@ std::vector<std::int32_t> NodeHalo<D>::shared_nodes(const CellBox<D>& a, const C
 template <int D>
 void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition, const Grid<D>& whole, int margin,
                         int partitions) {
-  pending_.wait();  // (the buffers below are replaced)
   comm_ = comm;
   rank_ = comm.rank();
   margin_ = margin;
@@ -87,25 +86,6 @@ void NodeHalo<D>::build(const Comm& comm, const Decomposition<D>& decomposition,
   }
   send_.assign(neighbours_.size(), {});
   recv_.assign(neighbours_.size(), {});
-  near_ = cells_reaching(mine, union_, margin - 1);
-}
-
-template <int D>
-std::vector<std::uint8_t> NodeHalo<D>::cells_reaching(const Grid<D>& window, const std::vector<std::int32_t>& nodes,
-                                                      int reach) {
-  // A stencil of reach r holds the nodes cell - r .. cell + 1 + r along each axis, so node u is
-  // held by the stencils of the cells u - 1 - r .. u + r.
-  std::vector<std::uint8_t> near(static_cast<std::size_t>(window.n_nodes()), 0);
-  for (std::int32_t u : nodes) {
-    const IVec<D> j = window.multi_index(u);
-    IVec<D> d = IVec<D>::Constant(-1 - reach);
-    for (int a = 0; a < D;) {
-      const std::int32_t cell = window.node_index(j + d);
-      if (cell >= 0) near[static_cast<std::size_t>(cell)] = 1;
-      for (a = 0; a < D && ++d[a] > reach; ++a) d[a] = -1 - reach;
-    }
-  }
-  return near;
 }
 
 template class NodeHalo<1>;

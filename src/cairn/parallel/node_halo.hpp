@@ -53,10 +53,6 @@ class NodeHalo {
   /// grid's node indices in increasing order (the order both sides pack them in).
   [[nodiscard]] static std::vector<std::int32_t> shared_nodes(const CellBox<D>& a, const CellBox<D>& b,
                                                               const Grid<D>& whole, int margin);
-  /// Per node of `window` (storage order): 1 where a stencil reaching `reach` cells beyond the
-  /// cell whose lowest node it is holds one of `nodes` (window storage indices), else 0.
-  [[nodiscard]] static std::vector<std::uint8_t> cells_reaching(const Grid<D>& window,
-                                                                const std::vector<std::int32_t>& nodes, int reach);
   /// Whether build() has been called with these arguments' geometry (same boxes, same margin).
   [[nodiscard]] bool built_for(int margin, int partitions) const {
     return margin == margin_ && partitions == partitions_;
@@ -68,18 +64,7 @@ class NodeHalo {
   /// the largest sum has run).
   template <class... T>
   void sum(int n_fields, std::vector<T>&... arrays) {
-    start(n_fields, arrays...);
-    finish(n_fields, arrays...);
-    settle();
-  }
-  /// sum() in two halves, so that work that neither reads nor writes the shared nodes can run
-  /// while the messages travel (parallel.overlap: the scatter of the particles whose stencils
-  /// reach no shared node, reaches_shared). start() sends the shared nodes' partials, which must
-  /// be complete; finish(), with the same arguments, forms the totals.
-  template <class... T>
-  void start(int n_fields, const std::vector<T>&... arrays) {
     if (neighbours_.empty()) return;
-    settle();  // the last sum's messages out before their buffers are reused
     const auto started = std::chrono::steady_clock::now();
     // (Values travel as bytes: doubles and fixed-size Eigen vectors, plain data both.)
     const std::size_t row = (sizeof(T) + ... + 0) * static_cast<std::size_t>(n_fields);
@@ -94,37 +79,12 @@ class NodeHalo {
         }
       bytes_sent_ += static_cast<std::int64_t>(send_[k].size());
     }
-    comm_.start_sized(neighbours_, send_, recv_, pending_);
-    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  }
-  template <class... T>
-  void finish(int n_fields, std::vector<T>&... arrays) {
-    if (neighbours_.empty()) return;
-    const auto started = std::chrono::steady_clock::now();
-    pending_.wait_received();  // (this rank's sends complete at the next start or settle)
-    const auto arrived = std::chrono::steady_clock::now();
-    wait_seconds_ += std::chrono::duration<double>(arrived - started).count();
-    const std::size_t field_bytes = (sizeof(T) + ... + 0);
+    const auto packed = std::chrono::steady_clock::now();
+    comm_.exchange_sized(neighbours_, send_, recv_);
+    wait_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - packed).count();
     std::size_t offset = 0;
-    ((combine(arrays, n_fields, field_bytes, offset), offset += sizeof(T)), ...);
+    ((combine(arrays, n_fields, row / static_cast<std::size_t>(n_fields), offset), offset += sizeof(T)), ...);
     seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  }
-  /// Complete the sends of the last sum (sum() does; after finish(), the next start() does).
-  void settle() {
-    if (neighbours_.empty()) return;
-    const auto started = std::chrono::steady_clock::now();
-    pending_.wait();
-    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    wait_seconds_ += took;
-    seconds_ += took;
-  }
-  /// Whether the stencil of a particle in the cell whose lowest node is window node `node`
-  /// can hold a node another window shares, for stencils reaching up to margin - 1 cells beyond
-  /// their cell (the reach the windows were built for). Always true for a node outside the
-  /// window, false on one rank.
-  [[nodiscard]] bool reaches_shared(std::int32_t node) const {
-    if (neighbours_.empty()) return false;
-    return node < 0 || near_[static_cast<std::size_t>(node)] != 0;
   }
 
   /// Where a neighbour's partial of a shared node arrives: neighbour k, row s of its message.
@@ -165,8 +125,7 @@ class NodeHalo {
   /// Seconds this rank has spent in sums so far (packing, exchange, totals).
   [[nodiscard]] double seconds() const { return seconds_; }
   /// Of those, the seconds in the exchange itself (waiting for the neighbours' messages): the
-  /// most that overlapping the exchange with other work could hide, or with parallel.overlap
-  /// what it left.
+  /// most that overlapping the exchange with other work could hide.
   [[nodiscard]] double wait_seconds() const { return wait_seconds_; }
 
  private:
@@ -210,8 +169,6 @@ class NodeHalo {
   std::vector<Holder> holders_;                     ///< the other holders of each, increasing rank
   std::vector<std::size_t> lower_;                  ///< per union_ node: holders below this rank
   Comm::Buffers send_, recv_;                       ///< per neighbour, kept between sums
-  Comm::Pending pending_;                           ///< the messages of a started sum
-  std::vector<std::uint8_t> near_;                  ///< per window node: reaches_shared
   std::int64_t bytes_sent_ = 0, message_bytes_ = 0;
   double seconds_ = 0.0, wait_seconds_ = 0.0;
 };

@@ -276,7 +276,6 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     velocity_conditions_.set_comm(comm);
     reach_ = std::max(1, shape_->ghost_layers());
     node_halo_ = config_.parallel.halo != "particles";
-    overlap_ = node_halo_ && config_.parallel.overlap;
     if (node_halo_ && contact_) contact_->use_halo(&halo_);  // (its point clouds and node arrays)
     distribution_.keep_storage_order(node_halo_);  // (sorted by cell block as a serial run's)
     grid_ = node_halo_ ? node_window() : distribution_.window(whole_, reach_);

@@ -298,8 +298,6 @@ class Simulation {
   Grid<D> grid_;   ///< the stored grid: whole_, or this rank's window of it
   Distribution<D> distribution_;
   bool node_halo_ = false;  ///< several ranks exchanging node sums (parallel.halo = nodes)
-  /// The node halo's particle-to-grid exchange overlaps the scatter (parallel.overlap).
-  bool overlap_ = false;
   NodeHalo<D> halo_;
   int reach_ = 1;             ///< stencil reach the window and ghost band are sized for
   double imbalance_ = 1.0;

@@ -189,13 +189,6 @@ void Simulation<D>::build_stencils() {
     shape_->build(grid_, particles_, cache_);
   }
   colour_blocks(grid_, particles_, cache_);
-  if (overlap_) {
-    // Particle-to-grid scatters first the particles whose stencils can reach a node shared with
-    // a neighbour, then the others while the sums of the shared nodes travel.
-    split_blocks(cache_, [&](std::int32_t p) {
-      return halo_.reaches_shared(grid_.node_index(grid_.cell_of(particles_.position[p])));
-    });
-  }
 }
 
 template <int D>
@@ -363,7 +356,7 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
   double* const mass_all = nodes_.mass.data();
   Vec<D>* const momentum_all = nodes_.momentum.data();
   Vec<D>* const force_all = nodes_.force.data();
-  auto extrapolate = [&](auto plain_tag, ScatterPart part) {
+  auto extrapolate = [&](auto plain_tag) {
     constexpr bool plain = decltype(plain_tag)::value;
     scatter(cache_, [&](std::int32_t p, const auto& stencil) {
       const std::int32_t off = field_offset(p);
@@ -393,33 +386,22 @@ void Simulation<D>::particles_to_grid(bool mass_and_momentum, bool forces) {
           }
         }
       });
-    }, part);
+    });
   };
-  auto scatter_part = [&](ScatterPart part) {
-    if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{}, part);
-    else extrapolate(std::false_type{}, part);
-  };
-  // A node-halo run completes the sums at the nodes its neighbours share, in one exchange (all
-  // four arrays in one message), after this rank's traction faces joined the forces.
-  auto with_summed = [&](auto&& fn) {
-    if (mass_and_momentum && forces && has_body_force) fn(nodes_.mass, nodes_.momentum, nodes_.force, node_body_force_);
-    else if (mass_and_momentum && forces) fn(nodes_.mass, nodes_.momentum, nodes_.force);
-    else if (mass_and_momentum) fn(nodes_.mass, nodes_.momentum);
-    else if (has_body_force) fn(nodes_.force, node_body_force_);
-    else fn(nodes_.force);
-  };
-  if (overlap_) {
-    // parallel.overlap: the exchange travels while the particles that reach no shared node
-    // scatter (split in build_stencils), so the shared nodes are complete when it starts.
-    scatter_part(ScatterPart::first);
-    if (forces) run_hooks(StepPoint::after_forces, step_dt_);  // (tractions: this rank's faces)
-    with_summed([&](auto&... arrays) { halo_.start(n_fields_, arrays...); });
-    scatter_part(ScatterPart::second);
-    with_summed([&](auto&... arrays) { halo_.finish(n_fields_, arrays...); });
-  } else {
-    scatter_part(ScatterPart::all);
-    if (forces) run_hooks(StepPoint::after_forces, step_dt_);
-    if (node_halo_) with_summed([&](auto&... arrays) { sum_halo(arrays...); });
+  if (mass_and_momentum && forces && !affine && !has_body_force) extrapolate(std::true_type{});
+  else extrapolate(std::false_type{});
+  if (forces) run_hooks(StepPoint::after_forces, step_dt_);  // (tractions: this rank's faces)
+  // A node-halo run completes the sums at the nodes its neighbours share, in one exchange.
+  if (node_halo_) {
+    if (mass_and_momentum && forces) {
+      if (has_body_force) sum_halo(nodes_.mass, nodes_.momentum, nodes_.force, node_body_force_);
+      else sum_halo(nodes_.mass, nodes_.momentum, nodes_.force);
+    } else if (mass_and_momentum) {
+      sum_halo(nodes_.mass, nodes_.momentum);
+    } else if (forces) {
+      if (has_body_force) sum_halo(nodes_.force, node_body_force_);
+      else sum_halo(nodes_.force);
+    }
   }
   if (mass_and_momentum) run_hooks(StepPoint::after_momentum, step_dt_);
 }

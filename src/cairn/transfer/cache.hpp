@@ -68,10 +68,6 @@ struct TransferCache {
   /// (an integer); the last entry is twice the colour's particle count. A scatter gives thread t
   /// of T the blocks of the t-th T-quantile (transfer/transfer.hpp, scatter).
   std::vector<std::vector<std::int64_t>> colour_rank;
-  /// A scatter in two parts (split_blocks, ScatterPart): each block's particles in the order of
-  /// `order`, those of the first part first; split_at[b] is where block b's second part starts.
-  std::vector<std::int32_t> split_order;
-  std::vector<std::int32_t> split_at;
   std::vector<std::int32_t> block_of;       ///< scratch: block of each particle
   std::vector<std::int32_t> cursor;         ///< scratch: per-thread block counts of the sort
   std::vector<std::int32_t> by_middle;      ///< scratch: a colour's blocks ranked by middle particle

@@ -275,53 +275,22 @@ std::vector<StencilEntry<D>> stencil_entries(const TransferCache<D>& cache, std:
   return out;
 }
 
-/// Which particles a scatter visits: all, or one part of the split made by split_blocks.
-enum class ScatterPart : std::uint8_t { all, first, second };
-
-/// Split every block's particles for a scatter in two parts (ScatterPart::first and second):
-/// those with first(p) true, then the others, each in the block's order. Call after
-/// colour_blocks; a scatter of both parts adds at every node the contributions of the first
-/// part's particles, then the second's, in an order independent of the thread count.
-template <int D, class First>
-void split_blocks(TransferCache<D>& cache, First&& first) {
-  const auto n_blocks = static_cast<std::int64_t>(cache.block_begin.size()) - 1;
-  cache.split_order.resize(cache.order.size());
-  cache.split_at.resize(static_cast<std::size_t>(std::max<std::int64_t>(n_blocks, 0)));
-#pragma omp parallel for schedule(dynamic, 1) if (static_cast<std::int64_t>(cache.n) >= particle_loop_min)
-  for (std::int64_t b = 0; b < n_blocks; ++b) {
-    const std::int32_t begin = cache.block_begin[b], end = cache.block_begin[b + 1];
-    std::int32_t* const out = cache.split_order.data();
-    std::int32_t at = begin, back = end;  // the second part fills from the end, reversed
-    for (std::int32_t i = begin; i < end; ++i) {
-      const std::int32_t p = cache.order[i];
-      if (first(p)) out[at++] = p;
-      else out[--back] = p;
-    }
-    std::reverse(out + at, out + end);
-    cache.split_at[b] = at;
-  }
-}
-
-/// Scatter: calls fn(p, stencil) for every particle p (or those of one part of split_blocks),
-/// race-free as above; fn may add into node arrays at the stencil's nodes. Up to
-/// affinity_max_particles particles each thread takes the blocks around its share of each
-/// colour's particles, the colour's blocks ranked by their middle particle (about the particles
-/// it builds and gathers, util/parallel.hpp); beyond, the blocks of a colour are handed out
-/// dynamically.
+/// Scatter: calls fn(p, stencil) for every particle p, race-free as above; fn may add into node
+/// arrays at the stencil's nodes. Up to affinity_max_particles particles each thread takes the
+/// blocks around its share of each colour's particles, the colour's blocks ranked by their middle
+/// particle (about the particles it builds and gathers, util/parallel.hpp); beyond, the blocks of
+/// a colour are handed out dynamically.
 template <int D, class Fn>
-void scatter(const TransferCache<D>& cache, Fn&& fn, ScatterPart part = ScatterPart::all) {
+void scatter(const TransferCache<D>& cache, Fn&& fn) {
   const auto n = static_cast<std::int64_t>(cache.n);
   const bool affinity = n <= affinity_max_particles;
-  const std::int32_t* const order = part == ScatterPart::all ? cache.order.data() : cache.split_order.data();
   with_stencils(cache, [&](auto stencil_of) {
     // One function for a block's particles, called from both schedules below: kept out of line
     // so that the particle work is compiled once, inlined into its loop (with two inlined copies
     // GCC stopped inlining the stencil's force sum, and P2G of (d) took 1.25x the time).
     auto run_block = [&](std::int32_t block) __attribute__((noinline)) {
-      const std::int32_t begin = part == ScatterPart::second ? cache.split_at[block] : cache.block_begin[block];
-      const std::int32_t end = part == ScatterPart::first ? cache.split_at[block] : cache.block_begin[block + 1];
-      for (std::int32_t i = begin; i < end; ++i) {
-        const std::int32_t p = order[i];
+      for (std::int32_t i = cache.block_begin[block]; i < cache.block_begin[block + 1]; ++i) {
+        const std::int32_t p = cache.order[i];
         fn(p, stencil_of(static_cast<std::size_t>(p)));
       }
     };
