@@ -304,8 +304,8 @@ TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
   ASSERT_GT(all.n(), 100u);
   std::vector<std::int64_t> seen;
   const ParticleSelection<2> select = [&](std::int64_t id, std::int32_t body, const Vec<2>& X, const Vec<2>& x,
-                                         bool replicated) {
-    EXPECT_TRUE(replicated);  // (one rank: every body generated whole)
+                                         bool in_share) {
+    EXPECT_FALSE(in_share);  // (one rank: every body generated whole, no rank's share)
     seen.push_back(id);
     const auto p = static_cast<std::size_t>(id);
     EXPECT_EQ(body, all.body[p]);

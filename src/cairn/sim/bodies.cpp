@@ -429,7 +429,7 @@ void create_particles(const Config& config, const Grid<D>& grid,
       // Any other body (point file or mesh elements, the radial arrangement, a displacement):
       // rank r takes the r-th block of its candidates, in creation order, and stores every
       // particle it makes wherever it lies (x = X + u(X) is known only here); the simulation
-      // sends them to their owners afterwards (Distribution::migrate). Ids: the counts of the
+      // sends them to their owners afterwards (Distribution::place). Ids: the counts of the
       // blocks before this rank's.
       const Comm& comm = *share->comm;
       const long long n_candidates = n_lattice + static_cast<long long>(seeds.size());
