@@ -10,13 +10,16 @@
 
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/grid_stencil.hpp"
 #include "cairn/wls/least_squares.hpp"
 #include "cairn/wls/weights.hpp"
 
 namespace cairn::wls {
 namespace {
 
-constexpr int pow3(int d) { return d == 0 ? 1 : 3 * pow3(d - 1); }
+using detail::corner_shape;
+using detail::for_each_corner_at;
+using detail::for_each_neighbour;
 
 /// fn(k) for the 3^D entries k (the node index along each axis, 0..2) of a WLS stencil, axis 0
 /// fastest: the order of the sums, the same for every particle. Inlined with its callers' bodies
@@ -35,27 +38,6 @@ template <int D, class Fn>
   }
 }
 
-/// fn(nb, offset) for every node nb of the 3^D block around node i (itself included) that the
-/// grid holds; offset = position of nb minus that of i, in cells.
-template <int D, class Fn>
-void for_each_neighbour(const Grid<D>& grid, std::int32_t i, Fn&& fn) {
-  const IVec<D> j = grid.multi_index(i);
-  std::array<int, D> k{};
-  for (int s = 0; s < pow3(D); ++s) {
-    IVec<D> jn = j;
-    Vec<D> offset;
-    for (int a = 0; a < D; ++a) {
-      jn[a] += k[a] - 1;
-      offset[a] = k[a] - 1;
-    }
-    for (int a = 0; a < D; ++a) {
-      if (++k[a] < 3) break;
-      k[a] = 0;
-    }
-    const std::int32_t nb = grid.node_index(jn);
-    if (nb >= 0) fn(nb, offset);
-  }
-}
 
 /// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
 constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
@@ -72,44 +54,6 @@ constexpr int voigt(int a, int b) {
   }
 }
 
-/// Narrow shape value and gradient of corner `corner` (bit a: upper node along a) of a cell at the
-/// local coordinates xi in [0, 1]^D: the cell-wise form of seed 001 Eq. 5-6 (a point on a node
-/// takes the cell it lies in, so sum S = 1 and sum G = 0 hold everywhere).
-template <int D>
-void corner_shape(int corner, const Vec<D>& xi, const Vec<D>& inv_h, double& S, Vec<D>& G) {
-  S = 1.0;
-  G.setOnes();
-  for (int a = 0; a < D; ++a) {
-    const bool up = (corner >> a) & 1;
-    const double s = up ? xi[a] : 1.0 - xi[a];
-    const double g = (up ? 1.0 : -1.0) * inv_h[a];
-    S *= s;
-    for (int b = 0; b < D; ++b) G[b] *= (a == b) ? g : s;
-  }
-}
-
-/// fn(node, S, G) for the corners of the cell holding x that the grid holds: the narrow shape of
-/// seed 001 Eq. 5-6 at x.
-template <int D, class Fn>
-void for_each_corner_at(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& inv_h, Fn&& fn) {
-  const Vec<D> u = grid.to_cell_units(x);
-  IVec<D> cell;
-  Vec<D> local;
-  for (int a = 0; a < D; ++a) {
-    cell[a] = static_cast<int>(std::floor(u[a]));
-    local[a] = u[a] - cell[a];
-  }
-  for (int corner = 0; corner < (1 << D); ++corner) {
-    IVec<D> j = cell;
-    for (int a = 0; a < D; ++a) j[a] += (corner >> a) & 1;
-    const std::int32_t node = grid.node_index(j);
-    if (node < 0) continue;
-    double S;
-    Vec<D> G;
-    corner_shape<D>(corner, local, inv_h, S, G);
-    fn(node, S, G);
-  }
-}
 
 }  // namespace
 
@@ -621,86 +565,6 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     }
     nodes.force[i] += fi;
   });
-}
-
-template <int D>
-void Integrator<D>::spread_surface_loads(const Grid<D>& grid) {
-  // A traction is defined on the particles' faces (seed 000 Sec. 2.4), but the body the method
-  // integrates is the union of the cut-cell regions (Eq. 18), and Eq. 24's internal force of a
-  // uniform stress sigma is -sigma a_i with a_i = sum_q G_iq V_q, which in 2D is exactly the
-  // integral of S_i n over the regions' surface (the patch test
-  // UniformStressForceIsTheSurfaceTractionIntegral; inner cell faces cancel). A group's force
-  // F (sum of T A_s over its faces, outward direction n) is spread over the nodes near its faces
-  // in proportion to max(0, n . a_i), the area of the cut-cell surface facing n that each node
-  // carries: then the loaded body's stress T (x) n balances the load node by node, also at the
-  // nodes that see only a sliver of a cut cell, whose mass is O(eps^2) (Eq. 22) while their
-  // forces are O(eps). Not in seed 001, which defines no tractions (docs/wls.md).
-  const auto n_groups = static_cast<std::int32_t>(loads_.force.size());
-  std::fill(surface_force_.begin(), surface_force_.end(), Vec<D>::Zero());
-  std::fill(load_stamp_.begin(), load_stamp_.end(), -1);
-  const Vec<D> inv_h = h_.cwiseInverse();
-  for (std::int32_t g = 0; g < n_groups; ++g) {
-    const double area = loads_.normal[g].norm();
-    if (!(area > 0.0)) continue;
-    const Vec<D> n = loads_.normal[g] / area;
-    // The nodes of the 3^D blocks around the nearest nodes of the group's face centres.
-    load_nodes_.clear();
-    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
-      if (loads_.group[f] != g) continue;
-      const Vec<D> x = grid.to_cell_units(loads_.centre[f]);
-      for (int s = 0; s < pow3(D); ++s) {
-        IVec<D> j;
-        for (int a = 0, k = s; a < D; ++a, k /= 3) j[a] = static_cast<int>(std::lround(x[a])) + k % 3 - 1;
-        const std::int32_t i = grid.node_index(j);
-        if (i < 0 || load_stamp_[i] == g) continue;
-        load_stamp_[i] = g;
-        load_nodes_.push_back(i);
-      }
-    }
-    double sum = 0.0;
-    for (std::int32_t i : load_nodes_) sum += std::max(0.0, n.dot(surface_vector_[i]));
-    if (sum > 1e-9 * area) {
-      for (std::int32_t i : load_nodes_)
-        surface_force_[i] += (std::max(0.0, n.dot(surface_vector_[i])) / sum) * loads_.force[g];
-      continue;
-    }
-    // No cut-cell surface faces the group (it lies outside every region): each face's force by
-    // the narrow shape S of Eq. 5 at its centre, as MPM's linear family would.
-    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
-      if (loads_.group[f] != g) continue;
-      for_each_corner_at(grid, loads_.centre[f], inv_h, [&](std::int32_t i, double S, const Vec<D>&) {
-        surface_force_[i] += S * loads_.face_force[f];
-      });
-    }
-  }
-}
-
-template <int D>
-void Integrator<D>::filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes) {
-  // dv_i = v+_i - v_i = a_i dt replaced by the planar least-squares fit (Eq. 7-12 on the grid)
-  // over the node and its 3^D - 1 neighbours that carry mass, weighted by W(x_j - x_i) m_j:
-  // linear acceleration fields pass unchanged, the node-to-node zig-zag a single node's small
-  // cut-cell mass and force produce does not (docs/wls.md).
-  const std::int32_t n_nodes = grid.n_nodes();
-  filtered_.resize(n_nodes);
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    filtered_[i] = nodes.velocity_new[i] - nodes.velocity[i];
-    if (!(nodes.mass[i] > 0.0)) return;
-    typename PlaneFit<D>::Matrix M = PlaneFit<D>::Matrix::Zero();
-    Eigen::Matrix<double, n_basis, D> load = Eigen::Matrix<double, n_basis, D>::Zero();
-    for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& r) {
-      if (!(nodes.mass[nb] > 0.0)) return;
-      double w = 1.0;
-      for (int a = 0; a < D; ++a) w *= wide_weight(r[a], 1.0);
-      w *= nodes.mass[nb];
-      const auto b = PlaneFit<D>::basis(r);
-      M += w * b * b.transpose();
-      load += w * b * (nodes.velocity_new[nb] - nodes.velocity[nb]).transpose();
-    });
-    const auto inverse = PlaneFit<D>::inverse(M, false);
-    filtered_[i] = (inverse.row(0) * load).transpose();
-  });
-  for_each_node(n_nodes, [&](std::int32_t i) { nodes.velocity_new[i] = nodes.velocity[i] + filtered_[i]; });
 }
 
 template <int D>

@@ -1,0 +1,107 @@
+// The loads and corrections the WLS integrator applies at the nodes after its sums: the
+// tractions' spread over the cut-cell surface (docs/wls.md, departure 10) and the opt-in
+// acceleration filter.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "cairn/transfer/transfer.hpp"
+#include "cairn/wls/grid_stencil.hpp"
+#include "cairn/wls/integrator.hpp"
+#include "cairn/wls/least_squares.hpp"
+#include "cairn/wls/weights.hpp"
+
+namespace cairn::wls {
+
+using detail::for_each_corner_at;
+using detail::for_each_neighbour;
+using detail::pow3;
+
+template <int D>
+void Integrator<D>::spread_surface_loads(const Grid<D>& grid) {
+  // A traction is defined on the particles' faces (seed 000 Sec. 2.4), but the body the method
+  // integrates is the union of the cut-cell regions (Eq. 18), and Eq. 24's internal force of a
+  // uniform stress sigma is -sigma a_i with a_i = sum_q G_iq V_q, which in 2D is exactly the
+  // integral of S_i n over the regions' surface (the patch test
+  // UniformStressForceIsTheSurfaceTractionIntegral; inner cell faces cancel). A group's force
+  // F (sum of T A_s over its faces, outward direction n) is spread over the nodes near its faces
+  // in proportion to max(0, n . a_i), the area of the cut-cell surface facing n that each node
+  // carries: then the loaded body's stress T (x) n balances the load node by node, also at the
+  // nodes that see only a sliver of a cut cell, whose mass is O(eps^2) (Eq. 22) while their
+  // forces are O(eps). Not in seed 001, which defines no tractions (docs/wls.md).
+  const auto n_groups = static_cast<std::int32_t>(loads_.force.size());
+  std::fill(surface_force_.begin(), surface_force_.end(), Vec<D>::Zero());
+  std::fill(load_stamp_.begin(), load_stamp_.end(), -1);
+  const Vec<D> inv_h = h_.cwiseInverse();
+  for (std::int32_t g = 0; g < n_groups; ++g) {
+    const double area = loads_.normal[g].norm();
+    if (!(area > 0.0)) continue;
+    const Vec<D> n = loads_.normal[g] / area;
+    // The nodes of the 3^D blocks around the nearest nodes of the group's face centres.
+    load_nodes_.clear();
+    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
+      if (loads_.group[f] != g) continue;
+      const Vec<D> x = grid.to_cell_units(loads_.centre[f]);
+      for (int s = 0; s < pow3(D); ++s) {
+        IVec<D> j;
+        for (int a = 0, k = s; a < D; ++a, k /= 3) j[a] = static_cast<int>(std::lround(x[a])) + k % 3 - 1;
+        const std::int32_t i = grid.node_index(j);
+        if (i < 0 || load_stamp_[i] == g) continue;
+        load_stamp_[i] = g;
+        load_nodes_.push_back(i);
+      }
+    }
+    double sum = 0.0;
+    for (std::int32_t i : load_nodes_) sum += std::max(0.0, n.dot(surface_vector_[i]));
+    if (sum > 1e-9 * area) {
+      for (std::int32_t i : load_nodes_)
+        surface_force_[i] += (std::max(0.0, n.dot(surface_vector_[i])) / sum) * loads_.force[g];
+      continue;
+    }
+    // No cut-cell surface faces the group (it lies outside every region): each face's force by
+    // the narrow shape S of Eq. 5 at its centre, as MPM's linear family would.
+    for (std::size_t f = 0; f < loads_.group.size(); ++f) {
+      if (loads_.group[f] != g) continue;
+      for_each_corner_at(grid, loads_.centre[f], inv_h, [&](std::int32_t i, double S, const Vec<D>&) {
+        surface_force_[i] += S * loads_.face_force[f];
+      });
+    }
+  }
+}
+
+template <int D>
+void Integrator<D>::filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes) {
+  // dv_i = v+_i - v_i = a_i dt replaced by the planar least-squares fit (Eq. 7-12 on the grid)
+  // over the node and its 3^D - 1 neighbours that carry mass, weighted by W(x_j - x_i) m_j:
+  // linear acceleration fields pass unchanged, the node-to-node zig-zag a single node's small
+  // cut-cell mass and force produce does not (docs/wls.md).
+  const std::int32_t n_nodes = grid.n_nodes();
+  filtered_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    filtered_[i] = nodes.velocity_new[i] - nodes.velocity[i];
+    if (!(nodes.mass[i] > 0.0)) return;
+    typename PlaneFit<D>::Matrix M = PlaneFit<D>::Matrix::Zero();
+    Eigen::Matrix<double, n_basis, D> load = Eigen::Matrix<double, n_basis, D>::Zero();
+    for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& r) {
+      if (!(nodes.mass[nb] > 0.0)) return;
+      double w = 1.0;
+      for (int a = 0; a < D; ++a) w *= wide_weight(r[a], 1.0);
+      w *= nodes.mass[nb];
+      const auto b = PlaneFit<D>::basis(r);
+      M += w * b * b.transpose();
+      load += w * b * (nodes.velocity_new[nb] - nodes.velocity[nb]).transpose();
+    });
+    const auto inverse = PlaneFit<D>::inverse(M, false);
+    filtered_[i] = (inverse.row(0) * load).transpose();
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) { nodes.velocity_new[i] = nodes.velocity[i] + filtered_[i]; });
+}
+
+template void Integrator<1>::spread_surface_loads(const Grid<1>&);
+template void Integrator<1>::filter_acceleration(const Grid<1>&, NodeField<1>&);
+template void Integrator<2>::spread_surface_loads(const Grid<2>&);
+template void Integrator<2>::filter_acceleration(const Grid<2>&, NodeField<2>&);
+template void Integrator<3>::spread_surface_loads(const Grid<3>&);
+template void Integrator<3>::filter_acceleration(const Grid<3>&, NodeField<3>&);
+
+}  // namespace cairn::wls
