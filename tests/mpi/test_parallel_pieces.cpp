@@ -340,6 +340,29 @@ TEST(PerRankGeneration, ASelectionStoresItsParticlesWithTheirSerialIds) {
   EXPECT_EQ(none.n(), 0u);
 }
 
+TEST(PerRankGeneration, ALatticeBodyIsMadeIntoArraysReservedForItsCount) {
+  // A lattice body is made in two sweeps, the first counting (one bit per lattice point): the
+  // particle arrays are reserved for the count, not grown by doubling while they are filled, so
+  // the start-up holds no spare capacity (docs/parallel.md, the 2D block's memory). Two bodies:
+  // the second reserve grows the arrays to the sum.
+  Config c = test::box_config(2, "linear");
+  BodyConfig second = c.bodies[0];
+  second.name = "second";
+  second.shape.min = {0.75, 0.1};
+  second.shape.max = {0.95, 0.9};
+  c.bodies.push_back(second);
+  const Grid<2> grid(Vec<2>::Zero(), IVec<2>::Constant(10), Vec<2>::Constant(0.1), 1, {false, false});
+  std::vector<std::unique_ptr<Material>> materials;
+  materials.push_back(make_material(c.materials[0]));
+  Particles<2> made;
+  create_particles<2>(c, grid, materials, Mode::plane_strain, made);
+  ASSERT_GT(made.n(), 100u);
+  made.for_each_array([&](const auto& array, int width) {
+    EXPECT_EQ(array.capacity(), made.n() * static_cast<std::size_t>(width));
+  });
+  for (std::size_t p = 0; p < made.n(); ++p) EXPECT_EQ(made.id[p], static_cast<std::int64_t>(p));
+}
+
 }  // namespace
 }  // namespace cairn
 

@@ -91,6 +91,11 @@ struct Particles {
     state.resize(n * static_cast<std::size_t>(n_state_per_particle));
   }
 
+  /// Room for n particles in every array (particles made in a loop whose count is known).
+  void reserve(std::size_t n) {
+    for_each_array([n](auto& array, int width) { array.reserve(n * static_cast<std::size_t>(width)); });
+  }
+
   /// Release the spare capacity that adding particles one by one leaves (up to half the arrays).
   void shrink_to_fit() {
     for_each_array([](auto& array, int) { array.shrink_to_fit(); });

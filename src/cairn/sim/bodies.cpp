@@ -354,77 +354,91 @@ void create_particles(const Config& config, const Grid<D>& grid,
       for (std::size_t a = 0; a < n_bodies; ++a) shared[b][a] = static_cast<std::size_t>(sums[a + 1]);
       next_id += sums[0];
     };
-    // Per-rank generation of a plain lattice body (no seeds, no displacement): each rank tests
-    // only its own lattice points (generation_share; docs/parallel.md).
+    // A plain lattice body (no seeds, no displacement) is made in two sweeps over the lattice
+    // points: the first tests each point and keeps one bit, so that the particle arrays can be
+    // reserved for the count before the second makes the particles. On several ranks each rank
+    // sweeps only its own points (generation_share; docs/parallel.md).
     const bool plain = !radial && !points && !surface && !displacement;
     const bool ranks_share = share && share->comm && share->comm->parallel();
-    if (ranks_share && plain && total > 0) {
-      const Comm& comm = *share->comm;
-      // The inside lattice points this rank tests (k, in sweep order) and their ids.
-      std::vector<long long> mine;
-      std::vector<std::int64_t> id_of;
-      auto test = [&](long long k) {
-        const Vec<D> X = lattice_point(k);
-        if (!inside<D>(body.shape, image.get(), line_of[b], X)) return false;
-        if (margin == 0) tally(X, vol);
-        mine.push_back(k);
-        return true;
-      };
+    if (plain && total > 0 && (ranks_share || margin == 0)) {
       const long long rows = total / span[0];  // lines along x, in sweep order
-      if (!share->decomposition) {
-        // The census: rank r tests the r-th block of whole rows; ids follow the ranks' counts.
-        const auto r = static_cast<long long>(comm.rank()), n = static_cast<long long>(comm.size());
-        for (long long k = rows * r / n * span[0]; k < rows * (r + 1) / n * span[0]; ++k) test(k);
-        const std::int64_t first = next_id + comm.exclusive_prefix(static_cast<std::int64_t>(mine.size()));
-        for (std::size_t j = 0; j < mine.size(); ++j) id_of.push_back(first + static_cast<std::int64_t>(j));
-      } else {
-        // Rank r tests the points in the cells of its box. A row meets several ranks' boxes, in
-        // segments between the boxes' x faces: the counts per (row, segment), summed over the
-        // ranks, in sweep order, give every point its id.
-        const Decomposition<D>& dec = *share->decomposition;
-        std::vector<long long> cuts;  // lattice x indices (from box.lo) where a segment starts
-        for (int q = 0; q < dec.n_boxes(); ++q)
-          for (long long c : {static_cast<long long>(dec.box(q).lo[0]), static_cast<long long>(dec.box(q).hi[0])})
+      const Decomposition<D>* dec = ranks_share ? share->decomposition : nullptr;
+      // With a decomposition a row meets several ranks' boxes, in segments between the boxes'
+      // x faces: the counts per (row, segment), summed over the ranks, in sweep order, give
+      // every point its id.
+      std::vector<long long> cuts;  // lattice x indices (from box.lo) where a segment starts
+      std::array<long long, 3> lo{0, 0, 0}, hi{0, 0, 0};  // this rank's points, inclusive, from box.lo
+      if (dec) {
+        for (int q = 0; q < dec->n_boxes(); ++q)
+          for (long long c : {static_cast<long long>(dec->box(q).lo[0]), static_cast<long long>(dec->box(q).hi[0])})
             cuts.push_back(c * ppc[0] - box.lo[0]);
         std::sort(cuts.begin(), cuts.end());
         cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-        const auto n_seg = static_cast<long long>(cuts.size());
-        auto segment = [&](long long i) {
-          return static_cast<long long>(std::upper_bound(cuts.begin(), cuts.end(), i) - cuts.begin()) - 1;
-        };
-        const CellBox<D>& cells = dec.box(comm.rank());
-        std::array<long long, 3> lo{0, 0, 0}, hi{0, 0, 0};  // this rank's points, inclusive, from box.lo
+        const CellBox<D>& cells = dec->box(share->comm->rank());
         for (int a = 0; a < D; ++a) {
           lo[a] = std::max(box.lo[a], static_cast<long long>(cells.lo[a] - margin) * ppc[a]) - box.lo[a];
           hi[a] = std::min(box.hi[a], static_cast<long long>(cells.hi[a] + margin) * ppc[a] - 1) - box.lo[a];
         }
-        std::vector<std::int64_t> count(margin == 0 ? static_cast<std::size_t>(rows * n_seg) : 0, 0);
+      }
+      const auto n_seg = static_cast<long long>(cuts.size());
+      auto segment = [&](long long i) {
+        return static_cast<long long>(std::upper_bound(cuts.begin(), cuts.end(), i) - cuts.begin()) - 1;
+      };
+      // fn(k) for the lattice points this walk tests, in sweep order: all of them (serial), the
+      // r-th block of whole rows (the census on several ranks), or those in the cells of this
+      // rank's box.
+      auto sweep = [&](auto&& fn) {
+        if (!dec) {
+          const auto r = ranks_share ? static_cast<long long>(share->comm->rank()) : 0LL;
+          const auto n = ranks_share ? static_cast<long long>(share->comm->size()) : 1LL;
+          for (long long k = rows * r / n * span[0]; k < rows * (r + 1) / n * span[0]; ++k) fn(k);
+          return;
+        }
         const long long stride2 = D == 3 ? span[std::min(1, D - 1)] : 0;  // rows per z layer
         if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
           for (long long i2 = lo[2]; i2 <= hi[2]; ++i2)
-            for (long long i1 = lo[1]; i1 <= hi[1]; ++i1) {
-              const long long row = i1 + stride2 * i2;
-              for (long long i0 = lo[0]; i0 <= hi[0]; ++i0)
-                if (test(i0 + span[0] * row) && margin == 0) ++count[static_cast<std::size_t>(row * n_seg + segment(i0))];
-            }
+            for (long long i1 = lo[1]; i1 <= hi[1]; ++i1)
+              for (long long i0 = lo[0]; i0 <= hi[0]; ++i0) fn(i0 + span[0] * (i1 + stride2 * i2));
+      };
+      std::vector<std::int64_t> count(dec && margin == 0 ? static_cast<std::size_t>(rows * n_seg) : 0, 0);
+      std::vector<bool> in;  // per tested point, in sweep order: inside the shape
+      std::size_t n_in = 0;
+      sweep([&](long long k) {
+        const Vec<D> X = lattice_point(k);
+        const bool yes = inside<D>(body.shape, image.get(), line_of[b], X);
+        in.push_back(yes);
+        if (!yes) return;
+        ++n_in;
+        if (margin > 0) return;
+        tally(X, vol);
+        if (dec) ++count[static_cast<std::size_t>(k / span[0] * n_seg + segment(k % span[0]))];
+      });
+      std::int64_t first = next_id;  // the first id (serial, census)
+      if (ranks_share && !dec) first += share->comm->exclusive_prefix(static_cast<std::int64_t>(n_in));
+      if (dec) {
         constexpr std::size_t chunk = 1u << 24;
         for (std::size_t at = 0; at < count.size(); at += chunk)
-          comm.sum(count.data() + at, static_cast<int>(std::min(chunk, count.size() - at)));
+          share->comm->sum(count.data() + at, static_cast<int>(std::min(chunk, count.size() - at)));
         std::int64_t before = 0;  // count -> the first id offset of each (row, segment)
         for (auto& c : count) before += std::exchange(c, before);
-        for (long long k : mine) {
-          if (margin > 0) {
-            id_of.push_back(-1);
-            continue;
-          }
-          const long long row = k / span[0];
-          std::int64_t& at = count[static_cast<std::size_t>(row * n_seg + segment(k % span[0]))];
-          id_of.push_back(next_id + at++);
-        }
       }
-      for (std::size_t j = 0; j < mine.size(); ++j) emit(mine[j], lattice_point(mine[j]), id_of[j], vol, mass, false);
+      // Room for the particles where this walk stores them: serially and in the walk over the
+      // rank's own box (the census and a selecting walk store none).
+      if (!ranks_share || (dec && margin == 0)) particles.reserve(particles.n() + n_in);
+      std::size_t j = 0;  // tested points so far
+      sweep([&](long long k) {
+        if (!in[j++]) return;
+        std::int64_t id = first++;
+        if (dec) {
+          id = margin > 0 ? -1 : next_id + count[static_cast<std::size_t>(k / span[0] * n_seg + segment(k % span[0]))]++;
+        }
+        emit(k, lattice_point(k), id, vol, mass, false);
+      });
       if (margin > 0) continue;  // a selecting walk: no ids, counts or checks
-      sum_tallies(comm);
+      if (ranks_share)
+        sum_tallies(*share->comm);
+      else
+        next_id += static_cast<std::int64_t>(n_in);
     } else if (ranks_share && margin == 0) {
       // Any other body (point file or mesh elements, the radial arrangement, a displacement):
       // rank r takes the r-th block of its candidates, in creation order, and stores every
