@@ -374,6 +374,29 @@ TEST(WlsArrangement, RadialRingsCoverTheAnnulusAndPutSurfaceRingsOnItsCircles) {
   double vol = 0.0;
   for (const auto& p : shells) vol += p.measure;
   EXPECT_NEAR(vol, 4.0 / 3.0 * std::numbers::pi * 0.064, 1e-12);
+  // In 3D an annulus is the hollow ball between two spheres: shells of points between the radii
+  // and surface shells on both spheres (verification/shell_mms).
+  s.kind = "annulus";
+  s.inner_radius = 0.5;
+  s.outer_radius = 1.0;
+  const auto hollow = wls::radial_arrangement<3>(s, 0.1, true);
+  double hollow_volume = 0.0;
+  int on_inner = 0, on_outer = 0;
+  for (const auto& p : hollow) {
+    hollow_volume += p.measure;
+    const double r = p.X.norm();
+    if (p.measure == 0.0) {
+      if (std::abs(r - 0.5) < 1e-12) ++on_inner;
+      else if (std::abs(r - 1.0) < 1e-12) ++on_outer;
+      else ADD_FAILURE() << "surface particle off the spheres at r = " << r;
+    } else {
+      EXPECT_GT(r, 0.5);
+      EXPECT_LT(r, 1.0);
+    }
+  }
+  EXPECT_NEAR(hollow_volume, 4.0 / 3.0 * std::numbers::pi * (1.0 - 0.125), 1e-12);
+  EXPECT_EQ(on_inner, static_cast<int>(std::lround(4 * std::numbers::pi * 0.25 / 0.01)));
+  EXPECT_EQ(on_outer, static_cast<int>(std::lround(4 * std::numbers::pi * 1.0 / 0.01)));
   s.kind = "box";
   EXPECT_THROW(wls::radial_arrangement<2>(s, 0.1, true), std::invalid_argument);
 }

@@ -286,7 +286,7 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                 .required()
                 .min(above_zero));
   k.push_back(Key("body.shape.annulus", "center", T::real_array,
-                 "Centre [x, y].")
+                 "Centre [x, y] (2D) or [x, y, z] (3D).")
                 .required());
   k.push_back(Key("body.shape.annulus", "inner_radius", T::real,
                  "Inner radius, below outer_radius.")
