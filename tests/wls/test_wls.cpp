@@ -343,30 +343,45 @@ TEST(WlsCutCell, SeparatedCornersInTheCubeAreTwoRegions) {
 
 // ---- arrangements -------------------------------------------------------------------------------
 
-TEST(WlsArrangement, RadialRingsCoverTheAnnulusAndPutSurfaceRingsOnItsCircles) {
+/// The radial arrangement of an annulus about `center` with radii 0.5 and 1 (a ring in 2D, the
+/// hollow ball in 3D): every volume point between the radii, the measures adding up to the
+/// annulus's, and each surface ring (shell) on its circle (sphere) with about spacing-apart points.
+template <int D>
+void expect_radial_annulus(const Vec<D>& center, double spacing) {
   BodyShapeConfig s;
   s.kind = "annulus";
-  s.center = {0.1, -0.2};
+  s.center.assign(center.data(), center.data() + D);
   s.inner_radius = 0.5;
   s.outer_radius = 1.0;
-  const auto seeds = wls::radial_arrangement<2>(s, 0.05, true);
-  double area = 0.0;
-  int n_surface_in = 0, n_surface_out = 0;
-  for (const auto& p : seeds) {
-    area += p.measure;
-    const double r = (p.X - Vec<2>(0.1, -0.2)).norm();
+  double measure = 0.0;
+  int on_inner = 0, on_outer = 0;
+  for (const auto& p : wls::radial_arrangement<D>(s, spacing, true)) {
+    measure += p.measure;
+    const double r = (p.X - center).norm();
     if (p.measure == 0.0) {
-      if (std::abs(r - 0.5) < 1e-12) ++n_surface_in;
-      else if (std::abs(r - 1.0) < 1e-12) ++n_surface_out;
-      else ADD_FAILURE() << "surface particle off the circles at r = " << r;
+      if (std::abs(r - 0.5) < 1e-12) ++on_inner;
+      else if (std::abs(r - 1.0) < 1e-12) ++on_outer;
+      else ADD_FAILURE() << "surface particle off the annulus's circles at r = " << r;
     } else {
       EXPECT_GT(r, 0.5);
       EXPECT_LT(r, 1.0);
     }
   }
-  EXPECT_NEAR(area, std::numbers::pi * 0.75, 1e-12);
-  EXPECT_EQ(n_surface_in, static_cast<int>(std::lround(2 * std::numbers::pi * 0.5 / 0.05)));
-  EXPECT_EQ(n_surface_out, static_cast<int>(std::lround(2 * std::numbers::pi * 1.0 / 0.05)));
+  const double pi = std::numbers::pi;
+  // ring: pi (1 - 0.25), 2 pi r / spacing points; shell: 4/3 pi (1 - 0.125), 4 pi r^2 / spacing^2
+  EXPECT_NEAR(measure, D == 2 ? pi * 0.75 : 4.0 / 3.0 * pi * 0.875, 1e-12);
+  auto points_on = [&](double r) {
+    return static_cast<int>(std::lround(D == 2 ? 2 * pi * r / spacing : 4 * pi * r * r / (spacing * spacing)));
+  };
+  EXPECT_EQ(on_inner, points_on(0.5));
+  EXPECT_EQ(on_outer, points_on(1.0));
+}
+
+TEST(WlsArrangement, RadialRingsCoverTheAnnulusAndPutSurfaceRingsOnItsCircles) {
+  expect_radial_annulus<2>(Vec<2>(0.1, -0.2), 0.05);
+  // In 3D an annulus is the hollow ball between two spheres (verification/shell_mms).
+  expect_radial_annulus<3>(Vec<3>(0.1, -0.2, 0.3), 0.1);
+  BodyShapeConfig s;
   s.kind = "sphere";
   s.center = {0.0, 0.0, 0.0};
   s.radius = 0.4;
@@ -374,29 +389,6 @@ TEST(WlsArrangement, RadialRingsCoverTheAnnulusAndPutSurfaceRingsOnItsCircles) {
   double vol = 0.0;
   for (const auto& p : shells) vol += p.measure;
   EXPECT_NEAR(vol, 4.0 / 3.0 * std::numbers::pi * 0.064, 1e-12);
-  // In 3D an annulus is the hollow ball between two spheres: shells of points between the radii
-  // and surface shells on both spheres (verification/shell_mms).
-  s.kind = "annulus";
-  s.inner_radius = 0.5;
-  s.outer_radius = 1.0;
-  const auto hollow = wls::radial_arrangement<3>(s, 0.1, true);
-  double hollow_volume = 0.0;
-  int on_inner = 0, on_outer = 0;
-  for (const auto& p : hollow) {
-    hollow_volume += p.measure;
-    const double r = p.X.norm();
-    if (p.measure == 0.0) {
-      if (std::abs(r - 0.5) < 1e-12) ++on_inner;
-      else if (std::abs(r - 1.0) < 1e-12) ++on_outer;
-      else ADD_FAILURE() << "surface particle off the spheres at r = " << r;
-    } else {
-      EXPECT_GT(r, 0.5);
-      EXPECT_LT(r, 1.0);
-    }
-  }
-  EXPECT_NEAR(hollow_volume, 4.0 / 3.0 * std::numbers::pi * (1.0 - 0.125), 1e-12);
-  EXPECT_EQ(on_inner, static_cast<int>(std::lround(4 * std::numbers::pi * 0.25 / 0.01)));
-  EXPECT_EQ(on_outer, static_cast<int>(std::lround(4 * std::numbers::pi * 1.0 / 0.01)));
   s.kind = "box";
   EXPECT_THROW(wls::radial_arrangement<2>(s, 0.1, true), std::invalid_argument);
 }
