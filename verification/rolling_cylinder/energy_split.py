@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Where the rolling disk's lost acceleration goes (issue 38, item 3; README "Where the rolling error goes").
 
-    energy_split.py R_OVER_H [R_OVER_H ...] [--impulse] [--cairn BIN] [--out DIR]
+    energy_split.py R_OVER_H [R_OVER_H ...] [--impulse] [--contact KEY=VALUE ...] [--cairn BIN] [--out DIR]
 
 Runs the case's rolling input (mu = 0.5, theta = 30 deg, rolling settings) at each R/h and splits
 the work gravity did over the fit window into the disk's rigid-body kinetic energy (translation and
@@ -69,14 +69,19 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("r_over_h", nargs="+", type=float)
     p.add_argument("--impulse", action="store_true", help='first_correction = "impulse"')
+    p.add_argument("--contact", action="append", default=[], metavar="KEY=VALUE",
+                   help='a [contact] key over the rolling settings, e.g. release=gap (string values)')
     p.add_argument("--cairn", default=str(HERE.parents[1] / "build" / "release" / "cairn"))
     p.add_argument("--out", default=str(HERE / "results" / "energy_split"))
     args = p.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for n in args.r_over_h:
-        name = f"roll30_mu0.5_Rh{n:g}" + ("_impulse" if args.impulse else "")
-        extra = {"first_correction": "impulse"} if args.impulse else None
+        extra = {"first_correction": "impulse"} if args.impulse else {}
+        extra.update(kv.split("=", 1) for kv in args.contact)
+        name = f"roll30_mu0.5_Rh{n:g}" + ("_impulse" if args.impulse else "") + \
+            "".join(f"_{k}_{v}" for k, v in extra.items() if k != "first_correction")
+        extra = extra or None
         toml = rc.make_input(name, rc.R / n, math.radians(30.0), 0.5, out, extra=extra)
         subprocess.run([args.cairn, "run", str(toml), "-q", "--set", "simulation.threads=1"], check=True)
         split(out / name, n)

@@ -249,6 +249,7 @@ struct ContactConfig {
   double critical_separation = 0.8; ///< cp: delta_c in cells (seed 004 Eq. 16)
   double touching_tolerance = 1e-3; ///< lr/df: touching when the separation < this many cells
   std::string lr_separation = "cloud";  ///< lr detection edges: cloud (Eq. 22-24) | column (the node's column)
+  std::string release = "gap";      ///< gap (both tests every step, seed 004) | separation (in contact until the fields separate)
   std::string corrections = "twice";///< twice | once (seed 004 Sec. 3.2)
   std::string three_or_more = "lump";  ///< lump (Eq. 50) | pairs
   bool xpic_correction = true;      ///< the Delta v term of multimaterial XPIC/FMPM (Eq. 37)

@@ -101,6 +101,7 @@ Contact<D>::Contact(const Config& config, const Grid<D>& grid, const Particles<D
   twice_ = cfg_.corrections == "twice";
   xpic_correction_ = cfg_.xpic_correction;
   impulse_ = cfg_.first_correction == "impulse";
+  release_by_separation_ = cfg_.release == "separation";
   if (by_body_)
     for (const auto& b : config.bodies) field_names_.push_back(b.name);
   else
@@ -646,7 +647,12 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       // Contact needs approach, (v_b - v_a).n < 0 (Eq. 14), and touching (separation < 0).
       if (!(it.normal.squaredNorm() > 0.0)) return traced(S::no_normal, Vec3::Zero());
       if (!(in.dp0.dot(it.normal) < 0.0)) return traced(S::separating, Vec3::Zero());
-      if (!(it.separation < 0.0)) return traced(S::gap_open, Vec3::Zero());
+      // release = "separation": a pair in contact at the last step's second correction stays in
+      // contact while it approaches; the separation decides only when contact begins.
+      const std::int64_t key = release_by_separation_ ? pair_key(node, it.a, it.b) : 0;
+      if (!(it.separation < 0.0) && !(release_by_separation_ && in_contact_.count(key)))
+        return traced(S::gap_open, Vec3::Zero());
+      if (release_by_separation_ && record) in_contact_next_.insert(key);
       const Vec3 d = L.momentum_change(in);
       return traced((d - in.dp0).squaredNorm() == 0.0 ? S::stick : S::slip, d);
     };
@@ -742,6 +748,20 @@ void Contact<D>::correct(const std::vector<double>& mass, std::vector<Vec<D>>& v
       }
     }
   }
+  if (release_by_separation_ && record) {
+    in_contact_.swap(in_contact_next_);
+    in_contact_next_.clear();
+  }
+}
+
+template <int D>
+std::int64_t Contact<D>::pair_key(std::int32_t node, int a, int b) const {
+  const IVec<D> j = grid_->multi_index(node);
+  const int g = grid_->ghost_layers();
+  std::int64_t index = 0;
+  for (int axis = 0; axis < D; ++axis) index = index * (grid_->n_cells()[axis] + 1 + 2 * g) + (j[axis] + g);
+  const std::int64_t nf = n_fields() + 1;
+  return (index * nf + a) * nf + (b < 0 ? nf - 1 : b);
 }
 
 template <int D>

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -149,6 +150,9 @@ class Contact {
   [[nodiscard]] double contact_area(const Vec3& n) const;
   [[nodiscard]] int law_of(int a, int b) const { return pair_law_[static_cast<std::size_t>(a * n_fields() + b)]; }
   [[nodiscard]] double edge_distance(double s) const;  ///< DF: d(s) of a field on the -n side
+  /// release = "separation": the pair (a, b) at a node, keyed by the node's domain multi-index
+  /// (the same on every rank and window); b = -1 the lumped others.
+  [[nodiscard]] std::int64_t pair_key(std::int32_t node, int a, int b) const;
 
   const Grid<D>* grid_;
   ContactConfig cfg_;
@@ -156,6 +160,10 @@ class Contact {
   bool twice_ = true;
   bool xpic_correction_ = true;
   bool impulse_ = false;
+  bool release_by_separation_ = false;  ///< release = "separation"
+  /// release = "separation": the pairs the last updated pass held in contact (read by both passes
+  /// of this step), and those this step's updated pass holds (pair_key).
+  std::unordered_set<std::int64_t> in_contact_, in_contact_next_;
   double small_mass_ = 0.0;
   std::int32_t n_nodes_ = 0;
   std::vector<std::string> field_names_;

@@ -383,6 +383,7 @@ void Loader::read_contact(const toml::table& root, Config& cfg) {
   c.critical_separation = r.real("critical_separation");
   c.touching_tolerance = r.real("touching_tolerance");
   c.lr_separation = r.string("lr_separation");
+  c.release = r.string("release");
   c.corrections = r.string("corrections");
   c.three_or_more = r.string("three_or_more");
   c.xpic_correction = r.boolean("xpic_correction");

@@ -119,6 +119,16 @@ void declare_condition_keys(std::vector<KeyDecl>& k) {
                  "docs/contact.md, \"Rolling\").")
                 .by_default("\"cloud\"")
                 .choices([] { return std::vector<std::string>{"cloud", "column"}; }));
+  k.push_back(Key("contact", "release", T::string,
+                 "When a node in contact leaves it: gap (seed 004: contact needs approach and "
+                 "touching at every step) or separation (a field pair that the last step's second "
+                 "correction held in contact at a node stays in contact there, whatever the "
+                 "separation, until its fields no longer approach; the separation only decides "
+                 "when contact begins, so that a gap of a fraction of a percent of a cell that the "
+                 "particles' discreteness opens under load does not drop it; docs/contact.md, "
+                 "\"Rolling\").")
+                .by_default("\"gap\"")
+                .choices([] { return std::vector<std::string>{"gap", "separation"}; }));
   k.push_back(Key("contact", "corrections", T::string,
                  "twice: correct the extrapolated momenta and the updated momenta (seed 004 Eq. "
                  "26-34); once: only the updated momenta (for comparison).")

@@ -279,6 +279,7 @@ std::string config_to_toml(const Config& c) {
     line("critical_separation", real_text(ct.critical_separation));
     line("touching_tolerance", real_text(ct.touching_tolerance));
     line("lr_separation", toml_string(ct.lr_separation));
+    line("release", toml_string(ct.release));
     line("corrections", toml_string(ct.corrections));
     line("three_or_more", toml_string(ct.three_or_more));
     line("xpic_correction", boolean(ct.xpic_correction));
