@@ -602,6 +602,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
   const bool from_quadrature = options_.quadrature_gradient;
+  const bool pic = options_.pic_velocity;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
   gather(cache_, [&](std::int64_t p, const auto&) {
@@ -633,7 +634,8 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       }
     });
     if (from_quadrature && weight > 0.0) L /= weight;
-    particles.velocity[p] += dv;
+    // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11).
+    particles.velocity[p] = pic ? vx : Vec<D>(particles.velocity[p] + dv);
     particles.position[p] += vx * dt;
     particle_gradient_[p] = L;
   });

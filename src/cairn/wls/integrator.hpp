@@ -68,6 +68,9 @@ struct Options {
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
   /// method.filter_acceleration: the step filters the grid velocity increments (docs/wls.md).
   bool filter_acceleration = false;
+  /// Particle velocity update: false = Eq. 27 as printed, V_p += sum S_ip (v+_i - v_i) (FLIP);
+  /// true = V_p = sum S_ip v+_i (PIC, seed 002 Eq. 1.66 without damping; docs/wls.md).
+  bool pic_velocity = false;
 };
 
 /// Loads on parts of the body's surface (tractions on particle faces, bc/traction.hpp), which
@@ -127,8 +130,8 @@ class Integrator {
   /// Node forces of the surface loads of the last collect (zero without loads).
   [[nodiscard]] const std::vector<Vec<D>>& surface_force() const { return surface_force_; }
 
-  /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v),
-  /// x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
+  /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v) (or, with
+  /// Options::pic_velocity, V = S v+), x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
   /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
   /// integration points' gradients.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);

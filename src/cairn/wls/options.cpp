@@ -16,6 +16,7 @@ Options options(const MethodConfig& method) {
   o.extrapolated_spurious_velocity = method.plugin.text("spurious_velocity") == "neighbours";
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
+  o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
   return o;
 }
 
@@ -63,6 +64,13 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "fit over it and its neighbours with mass (weights W m), so linear fields pass "
       "and the node-to-node zig-zag of small cut cells does not (docs/wls.md; not "
       "energy conserving); false = seed 001 as printed.")
-      .by_default("false")}});
+      .by_default("false"),
+    Key("", "particle_velocity", KeyType::string,
+      "WLS particle velocity update: flip = V_p += sum S_ip (v+_i - v_i) (seed 001 Eq. 27 "
+      "as printed); pic = V_p = sum S_ip v+_i (seed 002 Eq. 1.66), which keeps the "
+      "particles' velocity noise that the node fits cannot see out of the next fits "
+      "(docs/wls.md).")
+      .by_default("\"flip\"")
+      .choices([] { return std::vector<std::string>{"flip", "pic"}; })}});
 
 }  // namespace cairn::wls
