@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,6 +13,7 @@
 #include "cairn/contact/regression.hpp"
 #include "cairn/parallel/particle_transfer.hpp"
 #include "cairn/transfer/transfer.hpp"
+#include "cairn/util/scoped_seconds.hpp"
 
 namespace cairn {
 
@@ -30,18 +30,6 @@ Vec<D> offset_from_node(const Grid<D>& grid, std::int32_t node, const Vec<D>& x)
   }
   return d;
 }
-
-/// Adds the seconds of its lifetime to `total` (the contact cost counters).
-struct ScopedSeconds {
-  explicit ScopedSeconds(double& total) : total_(total) {}
-  ~ScopedSeconds() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
-  ScopedSeconds(const ScopedSeconds&) = delete;
-  ScopedSeconds& operator=(const ScopedSeconds&) = delete;
-
- private:
-  double& total_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
 
 /// The DF table: a semi-infinite row of undeformed particles of length lp (l = h / ppc) ending
 /// at e (in cells) on the -x side of the node at 0, extrapolated with the run's shape family in
