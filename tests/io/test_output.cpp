@@ -268,6 +268,7 @@ TYPED_TEST(CheckpointTest, RoundTripIsBitIdentical) {
   for (int r = 0; r < 4; ++r) data.history_rows.push_back({r * 0.1, double(r), 0.1 / 3.0, std::exp(r * 1.1)});
   data.snapshot_entries = {{0.0, "particles-000000.h5"}, {0.1 / 3.0, "particles-000001.h5"}};
   data.snapshot_next_index = 2;
+  data.contact_record = {7, 3, 7, 1LL << 40};  // [contact] release = "separation"; any order, repeats
   data.particles = random_particles<D>(37, 3, rng);
 
   const fs::path path = dir.path() / "checkpoint.h5";
@@ -285,6 +286,7 @@ TYPED_TEST(CheckpointTest, RoundTripIsBitIdentical) {
   EXPECT_EQ(back.history_rows, data.history_rows);
   EXPECT_EQ(back.snapshot_entries, data.snapshot_entries);
   EXPECT_EQ(back.snapshot_next_index, data.snapshot_next_index);
+  EXPECT_EQ(back.contact_record, data.contact_record);
   expect_particles_identical<D>(back.particles, data.particles);
 
   // Writing what was read gives the same checkpoint again.
@@ -307,6 +309,7 @@ TYPED_TEST(CheckpointTest, EmptyStateRoundTrips) {
   EXPECT_TRUE(back.history_columns.empty());
   EXPECT_TRUE(back.snapshot_entries.empty());
   EXPECT_TRUE(back.scalars.empty());
+  EXPECT_TRUE(back.contact_record.empty());
 }
 
 TEST(Checkpoint, WrongDimensionThrows) {

@@ -114,6 +114,20 @@ def engines(cairn, seeds, tmp):
     check(says(err, path, "engine", "fem", "mpm"), f"an MPM checkpoint holding an FEM input: exit 2, {err.strip()!r}")
 
 
+def contact_record(cairn, seeds, tmp):
+    # /contact/in_contact ([contact] release = "separation"): keys of the stored grid's nodes and
+    # contact fields only.
+    for key in (1 << 60, -1):
+        path = edited(seeds, tmp, "mpm_2d_contact.h5", f"contact_key_{key}.h5",
+                      lambda f: f.create_dataset("contact/in_contact", data=np.array([3, key], dtype=np.int64)))
+        err = restart(cairn, path)
+        check(says(err, path, "/contact/in_contact", f"the key {key}"), f"a contact record key {key}: exit 2, {err.strip()!r}")
+    path = edited(seeds, tmp, "mpm_2d_contact.h5", "contact_record_2d.h5",
+                  lambda f: f.create_dataset("contact/in_contact", data=np.zeros((2, 2), dtype=np.int64)))
+    err = restart(cairn, path)
+    check(says(err, path, "/contact/in_contact", "1D"), f"a 2D contact record: exit 2, {err.strip()!r}")
+
+
 def ranks(cairn, seeds, tmp):
     # Particles stored rank after rank by 2 ranks restart on one, to the next step.
     folder = os.path.join(tmp, "ranks")
@@ -132,13 +146,13 @@ def main():
     seeds = os.path.join(sys.argv[2], "tests/robustness/corpus/checkpoint/seeds")
     with tempfile.TemporaryDirectory(prefix="cairn_restart_mismatch_") as tmp:
         try:
-            for case in (dimensions, engines, ranks):
+            for case in (dimensions, engines, contact_record, ranks):
                 print(case.__name__)
                 case(cairn, seeds, tmp)
         except (CheckFailed, subprocess.TimeoutExpired) as e:
             print(f"FAIL: {e}", file=sys.stderr)
             return 1
-    print("ok: every mismatch of dimension and engine is exit 2 naming it")
+    print("ok: every mismatch of dimension and engine, and a bad contact record, is exit 2 naming it")
     return 0
 
 

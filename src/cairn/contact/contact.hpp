@@ -74,6 +74,17 @@ class Contact {
   /// count_first_correction(true) says that its change reaches the particle velocities.
   [[nodiscard]] double dissipated() const { return dissipated_; }
   void set_dissipated(double value) { dissipated_ = value; }
+  /// release = "separation": the field pairs the last updated pass held in contact (pair_key,
+  /// sorted; empty with release = "gap"), for checkpoints; restore_record() takes them back
+  /// (keys from the record of any rank count: a key of a node outside this rank's window is
+  /// never looked up). InputError-free: the caller checks the keys against record_key_end().
+  [[nodiscard]] std::vector<std::int64_t> record() const;
+  void restore_record(const std::vector<std::int64_t>& keys);
+  /// One past the largest pair key of this grid and field count.
+  [[nodiscard]] std::int64_t record_key_end() const;
+  /// Every rank's record on every rank (collective; after a repartition, so that a node moving
+  /// to another rank keeps its pairs).
+  void share_record(const Comm& comm);
   void count_first_correction(bool yes) { energy_from_first_ = yes; }
   /// The nodal velocities at the start of the step (slots), whose mean with the corrected
   /// updated velocities weighs the second correction's impulse (as the external work is weighed).

@@ -240,13 +240,31 @@ Checkpoint read_checkpoint(const fs::path& path) {
   }
   Checkpoint d;
   std::string where = "/";
+  std::error_code size_ec;
+  const double file_bytes = static_cast<double>(fs::file_size(path, size_ec));
   try {
     h5::Handle file = h5::open_file(path);
     const hid_t root = file.get();
+    // A shape declaring more values than the file's bytes can hold (gzip: about 1000 in the bytes
+    // of one) is refused before anything of that size is allocated, as the MPM reader does.
+    auto shape_of = [&](const std::string& name) {
+      const std::vector<std::size_t> shape = h5::dataset_shape(root, name);
+      double values = 1.0;
+      for (std::size_t n : shape) values *= static_cast<double>(n);
+      if (values * 8.0 > 1100.0 * file_bytes + 1e6)
+        refuse(where, "a dataset that the file's bytes can hold",
+               fmt::format("a shape of {:.6g} values in a file of {:.6g} bytes (a damaged or edited checkpoint)",
+                           values, file_bytes));
+      return shape;
+    };
+    auto text_list = [&](const std::string& name) {
+      (void)shape_of(name);
+      return h5::read_text_list(root, name);
+    };
     where = "/input";
     d.config_toml = h5::read_text(root, "input");
     where = "/scalar_names";
-    const auto names = h5::read_text_list(root, "scalar_names");
+    const auto names = text_list("scalar_names");
     where = "/scalar_values";
     const auto values = h5::read_doubles(root, "scalar_values", {names.size()});
     for (std::size_t k = 0; k < names.size(); ++k) d.scalars[names[k]] = values[k];
@@ -275,7 +293,7 @@ Checkpoint read_checkpoint(const fs::path& path) {
     // n x cols doubles, every one finite.
     auto read = [&](const std::string& name, std::size_t cols) {
       where = "/" + name;
-      const std::vector<std::size_t> shape = h5::dataset_shape(root, name);
+      const std::vector<std::size_t> shape = shape_of(name);
       if (cols > 0 ? shape.size() != 2 || shape[1] != cols : shape.size() != 1)
         refuse(where, cols > 0 ? fmt::format("an n x {} dataset", cols) : std::string("a 1D dataset"),
                fmt::format("{} axes{}", shape.size(), shape.size() == 2 ? fmt::format(" of {} columns", shape[1]) : ""));
@@ -296,9 +314,9 @@ Checkpoint read_checkpoint(const fs::path& path) {
     s.element_state = read("element_state", 0);
     s.temperature = read("temperature", 0);
     where = "/history_columns";
-    d.history_columns = h5::read_text_list(root, "history_columns");
+    d.history_columns = text_list("history_columns");
     where = "/history_rows";
-    const auto shape = h5::dataset_shape(root, "history_rows");
+    const auto shape = shape_of("history_rows");
     if (shape.size() != 2 || shape[1] != d.history_columns.size())
       refuse(where, fmt::format("rows x {} columns, as /history_columns lists", d.history_columns.size()),
              fmt::format("{} axes{}", shape.size(), shape.size() == 2 ? fmt::format(" of {} columns", shape[1]) : ""));
@@ -308,7 +326,7 @@ Checkpoint read_checkpoint(const fs::path& path) {
       d.history_rows.emplace_back(rows.begin() + static_cast<std::ptrdiff_t>(r * nc),
                                   rows.begin() + static_cast<std::ptrdiff_t>((r + 1) * nc));
     where = "/snapshot_files";
-    const auto files = h5::read_text_list(root, "snapshot_files");
+    const auto files = text_list("snapshot_files");
     where = "/snapshot_times";
     const auto times = h5::read_doubles(root, "snapshot_times", {files.size()});
     for (std::size_t k = 0; k < times.size() && k < files.size(); ++k) d.snapshots.emplace_back(times[k], files[k]);

@@ -285,6 +285,11 @@ void write_checkpoint(const fs::path& path, const CheckpointData<D>& data, const
       h5::write_doubles(g.get(), "times", times.data(), times.size());
       h5::write_text_list(g.get(), "files", files);
     }
+    // Every rank its own pairs, rank after rank (collective: the total decides for all).
+    if (const h5::Rows pairs = h5::rows_of(comm, data.contact_record.size()); pairs.total > 0) {
+      h5::Handle g = h5::create_group(root, "contact");
+      h5::write_int64s_rows(g.get(), "in_contact", data.contact_record.data(), pairs);
+    }
     {
       const Particles<D>& ps = particles;
       const int z = data.metadata.compression;
@@ -410,6 +415,14 @@ CheckpointData<D> read_checkpoint(const fs::path& path, const Comm& comm) {
       where = "/snapshots/times";
       const std::vector<double> times = h5::read_doubles(g.get(), "times", {files.size()});
       for (std::size_t i = 0; i < files.size(); ++i) data.snapshot_entries.emplace_back(times[i], files[i]);
+    }
+    if (h5::has_child(root, "contact")) {  // every rank reads all of the record
+      where = "/contact";
+      h5::Handle g = h5::open_group(root, "contact");
+      where = "/contact/in_contact";
+      const std::vector<std::size_t> s = shape_of(g.get(), "in_contact", 8);
+      if (s.size() != 1) refuse(path, where, "a 1D dataset (one key per field pair)", fmt::format("{} axes", s.size()));
+      data.contact_record = h5::read_int64s_rows(g.get(), "in_contact", 0, s[0]);
     }
     where = "/particles";
     h5::Handle g = h5::open_group(root, "particles");

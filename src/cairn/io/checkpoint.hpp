@@ -14,6 +14,9 @@
 //   /scalars/names, /scalars/values      run-loop scalars (string list, doubles)
 //   /history/columns, /history/rows      string list, rows x columns doubles
 //   /snapshots/times, /snapshots/files   snapshot listing (doubles, string list)
+//   /contact/in_contact                  int64, the field pairs held in contact at nodes (only
+//                                        with [contact] release = "separation"; each rank its
+//                                        own, a pair may appear twice; absent: none)
 //   /particles (attribute n_state_per_particle): position, reference_position, velocity, size0
 //     (n x 3, zero beyond D, as in snapshots; version 1: n x D), mass, volume0, temperature (n,
 //     only for thermal runs), deformation_gradient, kirchhoff_stress and, for APIC runs only,
@@ -48,6 +51,8 @@ struct CheckpointData {
   std::vector<std::vector<double>> history_rows;
   std::vector<std::pair<double, std::string>> snapshot_entries;
   int snapshot_next_index = 0;
+  /// [contact] release = "separation": the record of field pairs in contact (Contact::record).
+  std::vector<std::int64_t> contact_record;
   Particles<D> particles;
   OutputMetadata metadata;  ///< written as attributes (units, names, version); not read back
 };

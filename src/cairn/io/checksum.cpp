@@ -52,6 +52,20 @@ void check(bool ok, const std::string& what) {
   if (!ok) throw std::runtime_error("checksum: cannot read " + what);
 }
 
+/// A dataset or attribute of `obj` declaring `dims` of `element` bytes that the file's bytes
+/// cannot hold (gzip stores at most about 1000 values in the bytes of one, as read_checkpoint
+/// allows) is refused before its values are allocated: a damaged shape, not an allocation.
+void check_declared(hid_t obj, const std::vector<hsize_t>& dims, std::size_t element, const std::string& what) {
+  double bytes = static_cast<double>(element);
+  for (hsize_t d : dims) bytes *= static_cast<double>(d);
+  Id file{H5Iget_file_id(obj), H5Fclose};
+  hsize_t file_bytes = 0;
+  check(file.id >= 0 && H5Fget_filesize(file.id, &file_bytes) >= 0, "the file size for " + what);
+  if (bytes > 1100.0 * static_cast<double>(file_bytes) + 1e6)
+    throw std::runtime_error(fmt::format("checksum: {} declares {:.6g} bytes of values in a file of {} bytes",
+                                         what, bytes, file_bytes));
+}
+
 /// Type class, element size and (variable-length strings) by content: the shared part of
 /// datasets and attributes.
 void hash_type(Hash& h, hid_t type) {
@@ -89,6 +103,7 @@ void hash_attribute(Hash& h, hid_t obj, const char* name) {
   hash_type(h, type.id);
   std::vector<hsize_t> dims;
   hash_shape(h, space.id, dims);
+  check_declared(obj, dims, std::max<std::size_t>(H5Tget_size(type.id), sizeof(char*)), std::string("attribute ") + name);
   const auto count = static_cast<std::size_t>(std::max<hssize_t>(H5Sget_simple_extent_npoints(space.id), 0));
   if (H5Tis_variable_str(type.id) > 0) {
     hash_vlen_strings(h, type.id, space.id, count, [&](hid_t m, void* buf) { return H5Aread(attr.id, m, buf); },
@@ -120,6 +135,7 @@ void hash_dataset(Hash& h, hid_t dset, const std::string& path) {
   hash_type(h, type.id);
   std::vector<hsize_t> dims;
   hash_shape(h, space.id, dims);
+  check_declared(dset, dims, std::max<std::size_t>(H5Tget_size(type.id), sizeof(char*)), "dataset " + path);
   const auto count = static_cast<std::size_t>(std::max<hssize_t>(H5Sget_simple_extent_npoints(space.id), 0));
   if (count == 0) return;
   if (H5Tis_variable_str(type.id) > 0) {

@@ -176,6 +176,16 @@ class MpmEngine final : public Engine {
     for (const char* name : {"snapshots_done", "history_done", "checkpoints_done"}) (void)stored_count(data.scalars, name, file);
     if (stored_count(data.scalars, "checkpoint_index", file) > 1000000000)
       refuse("/scalars/values (checkpoint_index)", "a checkpoint index 0..1e9", "a larger one");
+    // The contact record (release = "separation"): keys of this grid's nodes and field pairs.
+    if (!data.contact_record.empty()) {
+      const std::int64_t end = sim_.contact() ? sim_.contact()->record_key_end() : 0;
+      for (std::int64_t key : data.contact_record)
+        if (key < 0 || key >= end)
+          refuse("/contact/in_contact",
+                 end > 0 ? fmt::format("keys 0..{} of the stored grid's nodes and contact fields", end - 1)
+                         : std::string("none (the stored input has no contact)"),
+                 fmt::format("the key {}", key));
+    }
     // Particle sizes: the stored input makes particles no larger than its largest (a larger
     // stored one would widen a GIMP or CPDI stencil past its limit in the first step).
     double largest[D] = {};
@@ -213,6 +223,7 @@ class MpmEngine final : public Engine {
     }
     sim_.set_particles(data.particles);
     n_particles_ = sim_.total_particles();
+    if (sim_.contact()) sim_.contact()->restore_record(data.contact_record);
     // contact_dissipated_energy: absent from checkpoints written before issue 38 (counted as 0).
     const auto contact_part = data.scalars.find("contact_dissipated_energy");
     sim_.restore_counters(data.time, data.step, data.scalars.at("external_work"),
@@ -400,6 +411,7 @@ class MpmEngine final : public Engine {
     data.snapshot_entries = snapshots_.entries();
     data.snapshot_next_index = snapshots_.next_index();
     data.metadata = meta_;
+    if (sim_.contact()) data.contact_record = sim_.contact()->record();
     cairn::write_checkpoint<D>(path, data, sim_.particles(), comm_);  // no copy of the particles
     last_checkpoint_ = path;
     return path;

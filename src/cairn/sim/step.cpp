@@ -235,8 +235,12 @@ void Simulation<D>::migrate_and_rebalance() {
   // are out of balance move (docs/parallel.md, "Load balance").
   distribution_.migrate(particles_);
   imbalance_ = distribution_.imbalance(particles_);
-  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold)
+  if (imbalance_ - 1.0 > config_.simulation.rebalance_threshold) {
+    const auto repartitions = distribution_.repartitions();
     distribution_.rebalance(particles_, config_.simulation.rebalance_threshold);
+    // Nodes change ranks: each takes the contact record with it (release = "separation").
+    if (contact_ && distribution_.repartitions() != repartitions) contact_->share_record(distribution_.comm());
+  }
 }
 
 template <int D>
