@@ -66,7 +66,7 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "thread); results do not depend on the thread count. false: always all threads.")
                 .by_default("true"));
   k.push_back(Key("simulation", "sort_particles", T::boolean,
-                 "Keep the particles of a run of 32768 or more particles in memory in the order "
+                 "Keep the particles of a run of 32768 or more particles (WLS: 8192) in memory in the order "
                  "of the grid's cell blocks, sorted again when they have moved out of it (the "
                  "particle-to-grid transfers then read memory in order; docs/performance.md). "
                  "Results are bit-identical either way and output lists particles in id order. "

@@ -385,9 +385,11 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
   // in id order whatever their storage order (transfer/colouring.cpp), and every other particle
   // stage works particle by particle or sums exactly, so the results do not change by a bit.
   const std::size_t n = particles_.n();
-  if (!config_.simulation.sort_particles || (distributed() && !node_halo_) || wls_ || n < sort_min_particles ||
-      particles_.id.size() != n)
+  if (!config_.simulation.sort_particles || (distributed() && !node_halo_) ||
+      n < (wls_ ? sort_min_particles_wls : sort_min_particles) || particles_.id.size() != n)
     return;
+  // A WLS run colours its particles in the integrator's own cache (wls/integrator.cpp).
+  TransferCache<D>& blocks = wls_ && !setup ? wls_->transfer_cache() : cache_;
   if (setup) {
     // No stencils yet: colour blocks of the preferred width (reach 0) in the cache's colouring
     // arrays (given back below).
@@ -399,12 +401,12 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
     cache_.colouring_valid = false;
     colour_blocks(grid_, particles_, cache_);
     cache_.colouring_valid = false;  // the stencils' reach may ask for wider blocks
-  } else if (!cache_.colouring_valid || cache_.order.size() != n) {
+  } else if (!blocks.colouring_valid || blocks.order.size() != n) {
     return;
   }
   // Runs of consecutive storage indices in the colouring's order: sorted, a block is one run
   // (and a particle that changed block since splits one).
-  const std::vector<std::int32_t>& order = cache_.order;
+  const std::vector<std::int32_t>& order = blocks.order;
   std::size_t breaks = 0;
   for (std::size_t k = 1; k < n; ++k) breaks += static_cast<std::size_t>(order[k] != order[k - 1] + 1);
   if (breaks * sort_run >= n) {
@@ -412,6 +414,10 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
     tractions_.renumber(order);
     cache_.sorted_storage = true;    // the colouring sorts each block by id (transfer/colouring.cpp)
     cache_.colouring_valid = false;  // block_of and order index the old storage
+    if (wls_) {
+      wls_->transfer_cache().sorted_storage = true;
+      wls_->transfer_cache().colouring_valid = false;
+    }
     compute_field_offsets();
     ++particle_sorts_;
   }
@@ -457,6 +463,10 @@ void Simulation<D>::set_particles(Particles<D> particles) {
     if (old_by_id.size() == particles_.n()) tractions_.renumber(old_by_id);
     cache_.sorted_storage = false;
     cache_.colouring_valid = false;
+    if (wls_) {
+      wls_->transfer_cache().sorted_storage = false;
+      wls_->transfer_cache().colouring_valid = false;
+    }
   }
   keep_particles_sorted(true);
   compute_field_offsets();

@@ -179,6 +179,9 @@ class Simulation {
   /// particles: particles-to-grid 1.75x faster, docs/performance.md). Smaller runs fit the
   /// caches in any order.
   static constexpr std::size_t sort_min_particles = 32768;
+  /// The same for WLS runs, whose step reads about four times the bytes per particle (stencils
+  /// with wide weights and offsets, the fitted fields' rows: docs/performance-notes.md, "WLS step").
+  static constexpr std::size_t sort_min_particles_wls = 8192;
   /// They are sorted again when the colouring's block order falls apart into runs of
   /// consecutive particles shorter than this on average.
   static constexpr std::size_t sort_run = 32;

@@ -189,6 +189,7 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
 template <int D>
 void Simulation<D>::wls_step(double dt) {
   step_dt_ = dt;
+  keep_particles_sorted(false);  // by the last step's colouring (before its stencils are rebuilt)
   WlsStages stages(*this);
   wls::step(*wls_, stages, grid_, particles_, nodes_, material_density_, dt);
   velocity_conditions_.finish_step();

@@ -114,6 +114,9 @@ class Integrator {
  public:
   Integrator(const Grid<D>& grid, const Options& options);
   [[nodiscard]] const Options& options() const { return options_; }
+  /// The particles' stencils and cell-block colouring of the last build_stencils (the engine
+  /// keeps a large run's particles in the colouring's block order: Simulation::keep_particles_sorted).
+  [[nodiscard]] TransferCache<D>& transfer_cache() { return cache_; }
 
   /// W, S and G of every particle over the 3^D nodes around its nearest node. Throws
   /// SimulationFailure when a particle left the grid.
