@@ -251,7 +251,7 @@ Checkpoint read_checkpoint(const fs::path& path) {
       const std::vector<std::size_t> shape = h5::dataset_shape(root, name);
       double values = 1.0;
       for (std::size_t n : shape) values *= static_cast<double>(n);
-      if (values * 8.0 > 1100.0 * file_bytes + 1e6)
+      if (!h5::file_can_hold(values * 8.0, file_bytes))
         refuse(where, "a dataset that the file's bytes can hold",
                fmt::format("a shape of {:.6g} values in a file of {:.6g} bytes (a damaged or edited checkpoint)",
                            values, file_bytes));

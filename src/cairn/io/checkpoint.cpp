@@ -360,7 +360,7 @@ CheckpointData<D> read_checkpoint(const fs::path& path, const Comm& comm) {
       const std::vector<std::size_t> shape = h5::dataset_shape(loc, name);
       double values = 1.0;
       for (std::size_t d : shape) values *= static_cast<double>(d);
-      if (values * static_cast<double>(bytes_per_row) > 1100.0 * file_bytes + 1e6)
+      if (!h5::file_can_hold(values * static_cast<double>(bytes_per_row), file_bytes))
         refuse(path, where, "a dataset that the file's bytes can hold",
                fmt::format("a shape of {:.6g} values in a file of {:.6g} bytes (a damaged or edited checkpoint)",
                            values, file_bytes));

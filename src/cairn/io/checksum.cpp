@@ -1,5 +1,7 @@
 #include "cairn/io/checksum.hpp"
 
+#include "cairn/io/hdf5_util.hpp"
+
 #include <fmt/format.h>
 #include <xxhash.h>
 
@@ -61,7 +63,7 @@ void check_declared(hid_t obj, const std::vector<hsize_t>& dims, std::size_t ele
   Id file{H5Iget_file_id(obj), H5Fclose};
   hsize_t file_bytes = 0;
   check(file.id >= 0 && H5Fget_filesize(file.id, &file_bytes) >= 0, "the file size for " + what);
-  if (bytes > 1100.0 * static_cast<double>(file_bytes) + 1e6)
+  if (!h5::file_can_hold(bytes, static_cast<double>(file_bytes)))
     throw std::runtime_error(fmt::format("checksum: {} declares {:.6g} bytes of values in a file of {} bytes",
                                          what, bytes, file_bytes));
 }

@@ -97,6 +97,13 @@ void write_doubles_box(hid_t loc, const std::string& name, const double* data, c
                                                        std::size_t count);
 [[nodiscard]] std::vector<std::int64_t> read_int64s_rows(hid_t loc, const std::string& name, std::size_t first,
                                                          std::size_t count);
+/// Whether a file of `file_bytes` bytes can hold a dataset of `declared_bytes` bytes of values:
+/// gzip stores at most about 1000 values in the bytes of one, so a shape above 1100 x the file's
+/// size (plus 1 MB) is damaged and is refused before anything of that size is allocated (the
+/// checkpoint readers and the content checksum's traversal; docs/robustness.md).
+[[nodiscard]] inline bool file_can_hold(double declared_bytes, double file_bytes) {
+  return declared_bytes <= 1100.0 * file_bytes + 1e6;
+}
 /// Open an existing HDF5 file read-only. Throws if it does not exist or is not HDF5.
 [[nodiscard]] Handle open_file(const std::filesystem::path& path);
 /// Create a group `name` below `loc`.
