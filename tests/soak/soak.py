@@ -13,6 +13,7 @@ build/release -L soak`. --minutes sets the length of the uninterrupted run (the 
 calibrated from a short run first); the interrupted one takes longer by its restarts.
 """
 import argparse
+import csv
 import os
 import random
 import signal
@@ -39,12 +40,12 @@ def command(args, ranks, verb, target, out, steps, extra=()):
                        "--set", f"simulation.max_steps={steps}", "--set", f'output.directory="{out}"', *halo, *extra]
 
 
-def settings(every, end):
+def settings(every, end, history=None):
     """The run: the spinning 3D block of tests/mpi/cases, run long (`end`: twice the simulated time
-    of the calibrated step count, so that the step count ends it), a checkpoint and a snapshot
-    every `every` simulated seconds."""
+    of the calibrated step count, so that the step count ends it), a checkpoint every `every`
+    simulated seconds, a snapshot every ten, a history row every `history` (default `every`)."""
     return ["--set", f"simulation.end_time={end!r}", "--set", f"output.checkpoint_every={every!r}",
-            "--set", f"output.every={every * 10!r}", "--set", f"output.history_every={every!r}"]
+            "--set", f"output.every={every * 10!r}", "--set", f"output.history_every={history or every!r}"]
 
 
 def newest_checkpoint(out):
@@ -67,15 +68,22 @@ def main():
     restart_ranks = args.restart_ranks or args.ranks
     args.out.mkdir(parents=True, exist_ok=True)
 
-    # Calibrate: steps per second of this machine for this run.
-    probe = args.out / "probe"
-    t0 = time.monotonic()
-    subprocess.run(command(args, args.ranks, "run", CASE, probe, 200, settings(1e-3, 1.0)), check=True,
-                   capture_output=True)
-    rate = 200 / (time.monotonic() - t0)
+    # Calibrate: steps per second of this machine for this run, from two probes of 200 and 800
+    # steps without checkpoints, as the run has almost none (their difference leaves out the
+    # start-up: timed from one probe of 200 steps with a checkpoint every 130, a soak asked for
+    # 60 minutes on 2 ranks ran 41).
+    took = []
+    for n in (200, 800):
+        probe = args.out / f"probe-{n}"
+        t0 = time.monotonic()
+        subprocess.run(command(args, args.ranks, "run", CASE, probe, n, settings(1.0, 1.0, history=1e-3)),
+                       check=True, capture_output=True)
+        took.append(time.monotonic() - t0)
+    rate = 600 / max(took[1] - took[0], 1e-3)
     steps = max(400, int(rate * args.minutes * 60))
-    with h5py.File(newest_checkpoint(probe), "r") as f:
-        dt = f.attrs["time"] / f.attrs["step"]
+    with open(probe / "history.csv") as f:
+        last = list(csv.DictReader(f))[-1]
+    dt = float(last["time"]) / float(last["step"])
     every = dt * steps / (8 * (args.kills + 1))  # about 8 checkpoints between two kills
     end = 2.0 * dt * steps
     print(f"soak: {steps} steps (about {args.minutes:g} min at {rate:.0f} steps/s), a checkpoint every "
