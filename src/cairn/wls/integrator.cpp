@@ -65,12 +65,10 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
     any_periodic_ |= periodic_[a];
   }
   const std::int32_t n = grid.n_nodes();
-  moment_.assign(n, {});
+  sums_.assign(n, NodeSums{});
   load_.assign(static_cast<std::size_t>(n) * n_basis * n_row, 0.0);
   coef_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
-  max_weight_.assign(n, 0.0);
   count_.assign(n, 0);
-  beta_.assign(n, 0.0);
   surface_sum_.assign(n, Vec<D>::Zero());
   surface_weight_.assign(n, 0.0);
   velocity_.assign(n, Vec<D>::Zero());
@@ -117,13 +115,22 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
         const double local = xi[a] - cell;
         std::int32_t* node = &cache_.axis_node[q + 3 * a];
         double* S = &cache_.axis_value[2 * q + 6 * a];
+        // The nodes nearest - 1 .. nearest + 1 start at the cell's lower node (shift 1) or one
+        // below it (shift 0): the narrow shape (Eq. 5) and its gradient (Eq. 6) are nonzero at
+        // the cell's two nodes, read here without a branch on which half of the cell x_p is in.
+        const int shift = nearest - cell == 1 ? 1 : 0;  // 0 or 1 (0 also for a NaN position)
+        const double shape[4] = {0.0, 1.0 - local, local, 0.0};
+        const double gradient[4] = {0.0, -inv_h[a], inv_h[a], 0.0};
         for (int k = 0; k < 3; ++k) {
           const int j = nearest - 1 + k;
-          const double r = xi[a] - j;                                      // x_p - x_i in cells
+          const double r = xi[a] - j;  // x_p - x_i in cells: in [0.5, 1.5), [-0.5, 0.5), [-1.5, -0.5)
           offset_[q + 3 * a + k] = r;
-          wide_[q + 3 * a + k] = wide_weight(r, 1.0);                      // Eq. 4
-          S[k] = j == cell ? 1.0 - local : j == cell + 1 ? local : 0.0;     // Eq. 5
-          S[3 + k] = j == cell ? -inv_h[a] : j == cell + 1 ? inv_h[a] : 0.0;  // Eq. 6
+          // Eq. 4 with h = 1 on each node's known branch (wide_weight(r, 1) to the bit; at
+          // r = -0.5 both branches give 0.5, at r = -1.5 both give 0).
+          const double w = 1.5 - std::abs(r);
+          wide_[q + 3 * a + k] = k == 1 ? 0.75 - r * r : w * w / 2.0;
+          S[k] = shape[k + shift];
+          S[3 + k] = gradient[k + shift];
           node[k] = grid.axis_index(a, j);
           outside |= node[k] < 0;
         }
@@ -170,11 +177,13 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   }
   const std::int32_t n_nodes = grid.n_nodes();
   for_each_node(n_nodes, [&](std::int32_t i) {
-    moment_[i].fill(0.0);
-    std::fill_n(&load_[static_cast<std::size_t>(i) * n_basis * n_row], n_basis * n_row, 0.0);
-    max_weight_[i] = 0.0;
+    // The sums change only where a weight W > 0 counted a particle (beta too: S > 0 implies
+    // W > 0, Eq. 4-5): nodes no particle counted last time are still zero (about half of them).
+    if (count_[i] != 0) {
+      sums_[i] = NodeSums{};
+      std::fill_n(&load_[static_cast<std::size_t>(i) * n_basis * n_row], n_basis * n_row, 0.0);
+    }
     count_[i] = 0;
-    beta_[i] = 0.0;
     surface_sum_[i].setZero();
     surface_weight_[i] = 0.0;
   });
@@ -209,7 +218,8 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
         const double r1 = D > 1 ? axis_r[3 + k[D > 1 ? 1 : 0]] : 0.0;
         const double r2 = D > 2 ? axis_r[6 + k[D > 2 ? 2 : 0]] : 0.0;
         const auto b = [&](int r) { return r == 0 ? 1.0 : r == 1 ? r0 : r == 2 ? r1 : r2; };
-        beta_[i] += S * flag;  // adds zero where S = 0
+        NodeSums& sum = sums_[i];
+        sum.beta += S * flag;  // adds zero where S = 0
         if (surface && S != 0.0) {
           // Along a periodic axis the particle's image next to the node (x_i + r h), so that
           // x_surf of a node on the seam averages the particles on both sides of it.
@@ -223,7 +233,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
           surface_weight_[i] += S;
         }
         if (W <= 0.0) return;
-        auto& M = moment_[i];
+        auto& M = sum.moment;
         for (int r = 0; r < n_basis; ++r)
           for (int c = r; c < n_basis; ++c) M[packed(r, c, n_basis)] += W * b(r) * b(c);
         // Per basis function a row of the fields: l_rk += (W f_k) b_r, along the row in pairs.
@@ -236,7 +246,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
             l[r * (n_row / 2) + m] += wf * b2;
           }
         }
-        max_weight_[i] = std::max(max_weight_[i], W);
+        sum.max_weight = std::max(sum.max_weight, W);
         ++count_[i];
       });
     });
@@ -272,8 +282,8 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
       on_symmetry[a] = (j[a] == 0 && options_.mirror[2 * a]) || (j[a] == n_cells_[a] && options_.mirror[2 * a + 1]);
       if (on_symmetry[a]) mirror *= 2.0;
     }
-    beta_[i] *= mirror;
-    distance_[i] = beta_[i] > 2.0 ? h : -h;  // first estimate, Eq. 14
+    sums_[i].beta *= mirror;
+    distance_[i] = sums_[i].beta > 2.0 ? h : -h;  // first estimate, Eq. 14
     if (surface_weight_[i] > 0.0) {
       surface_sum_[i] /= surface_weight_[i];  // x_i^surf, Eq. 15
       const Vec<D> xi = grid.node_position(i);
@@ -286,22 +296,29 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     stress_[i].setZero();
     inverse_[i].setZero();
     alpha_[i] = 0;
+    // The slopes of the fits are read only by the fitted point values and the extrapolated
+    // spurious velocity (options); otherwise the values c0 alone are formed (Eq. 11).
+    const bool slopes = options_.fitted_point_values || options_.extrapolated_spurious_velocity;
+    const int n_coef = slopes ? n_basis : 1;
     double* coef = &coef_[static_cast<std::size_t>(i) * n_fields * n_basis];
-    std::fill_n(coef, n_fields * n_basis, 0.0);
+    if (slopes) std::fill_n(coef, n_fields * n_basis, 0.0);
     if (count_[i] == 0) return;
     Eigen::Matrix<double, n_basis, n_basis> M;
     for (int r = 0; r < n_basis; ++r)
-      for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = moment_[i][packed(r, c, n_basis)];
+      for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = sums_[i].moment[packed(r, c, n_basis)];
     // Sec. 3.5: too few particles, or none above the trigger weight: constant fit only.
-    const bool reduce = count_[i] < D + 1 || max_weight_[i] < options_.trigger_weight;
+    const bool reduce = count_[i] < D + 1 || sums_[i].max_weight < options_.trigger_weight;
     bool reduced = true;
     inverse_[i] = PlaneFit<D>::inverse(M, reduce, &reduced);
     alpha_[i] = reduced ? 0 : 1;
     if (reduced) ++spurious[static_cast<std::size_t>(omp_get_thread_num())];
     const double* l = &load_[static_cast<std::size_t>(i) * n_basis * n_row];
     for (int k = 0; k < n_used; ++k)  // c = M^-1 l of field k (Eq. 10); zero slopes where reduced
-      for (int c = 0; c < n_basis; ++c)
-        for (int r = 0; r < n_basis; ++r) coef[k * n_basis + c] += inverse_[i](c, r) * l[r * n_row + k];
+      for (int c = 0; c < n_coef; ++c) {
+        double sum = 0.0;
+        for (int r = 0; r < n_basis; ++r) sum += inverse_[i](c, r) * l[r * n_row + k];
+        coef[k * n_basis + c] = sum;
+      }
     auto value = [&](int k) { return coef[k * n_basis]; };  // c0 of field k (Eq. 11)
     for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
     density_[i] = value(D);
@@ -331,7 +348,7 @@ template <int D>
 Eigen::Matrix<double, D + 1, D + 1> Integrator<D>::moment_matrix(std::int32_t i) const {
   Eigen::Matrix<double, n_basis, n_basis> M;
   for (int r = 0; r < n_basis; ++r)
-    for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = moment_[i][packed(r, c, n_basis)];
+    for (int c = r; c < n_basis; ++c) M(r, c) = M(c, r) = sums_[i].moment[packed(r, c, n_basis)];
   return M;
 }
 
@@ -371,7 +388,8 @@ void Integrator<D>::refine_distance(const Grid<D>& grid) {
     const Vec<D>& xs = surface_sum_[i];
     // Normal: gradient of the flag field at x_surf (Eq. 16), from the corners of its cell.
     Vec<D> normal = Vec<D>::Zero();
-    for_each_corner_at(grid, xs, inv_h, [&](std::int32_t node, double, const Vec<D>& G) { normal += G * beta_[node]; });
+    for_each_corner_at(grid, xs, inv_h,
+                       [&](std::int32_t node, double, const Vec<D>& G) { normal += G * sums_[node].beta; });
     const Vec<D> dv = xs - grid.node_position(i);
     const double along = dv.dot(normal);
     if (options_.projected_distance) {

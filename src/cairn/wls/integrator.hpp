@@ -155,7 +155,7 @@ class Integrator {
   [[nodiscard]] const std::vector<double>& node_density() const { return density_; }
   [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& node_stress() const { return stress_; }
   /// beta_i of Eq. 13 (with the mirror images across symmetry planes).
-  [[nodiscard]] const std::vector<double>& node_flags() const { return beta_; }
+  [[nodiscard]] double node_flag(std::int32_t i) const { return sums_[i].beta; }
   /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced.
   [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
   /// Moment matrix M of node i (Eq. 9, r in cells) from the last collect.
@@ -196,11 +196,17 @@ class Integrator {
   std::vector<double> offset_;         ///< n x D x 3: x_p - x_i in cells per axis
   std::vector<double> particle_fields_;///< n x n_row per-particle values of the step
   // node accumulators and results
-  std::vector<std::array<double, n_moment>> moment_;
+  /// What each stencil entry adds to its node besides the loads, in one place (one cache line in
+  /// 2D): the moment matrix M of Eq. 9 (packed upper triangle), the largest W (Sec. 3.5) and the
+  /// flag sum beta_i (Eq. 13).
+  struct alignas(D == 2 ? 64 : 32) NodeSums {
+    std::array<double, n_moment> moment;
+    double max_weight;
+    double beta;
+  };
+  std::vector<NodeSums> sums_;
   std::vector<double> load_;           ///< n_nodes x n_basis x n_row (l of Eq. 9, field fastest)
-  std::vector<double> max_weight_;
   std::vector<std::int32_t> count_;
-  std::vector<double> beta_;
   std::vector<Vec<D>> surface_sum_;    ///< sum S x over surface particles
   std::vector<double> surface_weight_; ///< sum S over surface particles
   std::vector<Vec<D>> velocity_;
