@@ -619,8 +619,10 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
                                    double dt) {
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
+  const auto& mass = nodes.mass;
   const bool from_quadrature = options_.quadrature_gradient;
   const bool pic = options_.pic_velocity;
+  const bool all_nodes = options_.massless_corners_included;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
   gather(cache_, [&](std::int64_t p, const auto&) {
@@ -630,6 +632,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
     double weight = 0.0;
+    bool massless = false;  // a node with S_ip > 0 and no mass
     for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
       std::int32_t i = 0;
       double S = 1.0;
@@ -637,6 +640,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
         i += axis_node[3 * a + k[a]];
         S *= axis_S[6 * a + k[a]];
       }
+      massless |= S != 0.0 && !(mass[i] > 0.0);
       dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
       vx += S * v_new[i];           // Eq. 28
       if (!from_quadrature) {
@@ -651,6 +655,33 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
         weight += S;
       }
     });
+    if (massless && !all_nodes) {
+      // A corner of the particle's cell that no integration region reaches (the particle lies on
+      // or beyond the cut surface) has no mass, hence no velocity or acceleration: Eq. 27-28
+      // summed over it lose the partition of unity, and a rigid translation would slow such a
+      // particle down (and then, through the next fits, its neighbours). Such a corner takes the
+      // S-weighted mean of the corners with mass: Eq. 27-28 over the corners with mass, divided
+      // by their sum of S (docs/wls.md, departure 12). Eq. 29 is left as printed (measured in
+      // docs/wls.md: the same mean there made plate_hole scatter more).
+      Vec<D> dv_m = Vec<D>::Zero(), vx_m = Vec<D>::Zero();
+      double S_m = 0.0;
+      for_each_slot<D>([&](const std::array<int, D>& k) {
+        std::int32_t i = 0;
+        double S = 1.0;
+        for (int a = 0; a < D; ++a) {
+          i += axis_node[3 * a + k[a]];
+          S *= axis_S[6 * a + k[a]];
+        }
+        if (!(mass[i] > 0.0)) return;
+        S_m += S;
+        dv_m += S * (v_new[i] - v[i]);
+        vx_m += S * v_new[i];
+      });
+      if (S_m > 0.0) {
+        dv = dv_m / S_m;
+        vx = vx_m / S_m;
+      }
+    }
     if (from_quadrature && weight > 0.0) L /= weight;
     // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11).
     particles.velocity[p] = pic ? vx : Vec<D>(particles.velocity[p] + dv);

@@ -71,6 +71,11 @@ struct Options {
   /// Particle velocity update: false = Eq. 27 as printed, V_p += sum S_ip (v+_i - v_i) (FLIP);
   /// true = V_p = sum S_ip v+_i (PIC, seed 002 Eq. 1.66 without damping; docs/wls.md).
   bool pic_velocity = false;
+  /// Nodes without mass in a particle's Eq. 27-28 (S_ip > 0: corners of its cell that no
+  /// integration region reaches): false = they take, for the particle, the S-weighted mean of the
+  /// corners with mass (the partition of unity kept; docs/wls.md, departure 12); true = their
+  /// zero velocity and acceleration enter the sums (as printed).
+  bool massless_corners_included = false;
 };
 
 /// Loads on parts of the body's surface (tractions on particle faces, bc/traction.hpp), which

@@ -17,6 +17,7 @@ Options options(const MethodConfig& method) {
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
+  o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
   return o;
 }
 
@@ -71,6 +72,14 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "particles' velocity noise that the node fits cannot see out of the next fits "
       "(docs/wls.md).")
       .by_default("\"flip\"")
-      .choices([] { return std::vector<std::string>{"flip", "pic"}; })}});
+      .choices([] { return std::vector<std::string>{"flip", "pic"}; }),
+    Key("", "empty_corners", KeyType::string,
+      "WLS particle update at corners of the particle's cell that carry no mass (no "
+      "integration region reaches them: the particle lies on or beyond the cut surface): "
+      "mean = such a corner takes the S-weighted mean of the corners with mass in Eq. "
+      "27-28, so a rigid motion moves the particle rigidly (docs/wls.md); zero = its zero "
+      "velocity and acceleration enter Eq. 27-28 (as printed).")
+      .by_default("\"mean\"")
+      .choices([] { return std::vector<std::string>{"mean", "zero"}; })}});
 
 }  // namespace cairn::wls
