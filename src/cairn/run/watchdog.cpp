@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "cairn/parallel/comm.hpp"
@@ -127,14 +128,48 @@ void StallWatchdog::watch() {
 }
 
 std::string StallWatchdog::diagnosis(long long step, double waited) const {
-  const double now = unix_seconds();
   const double period = write_period();
-  std::vector<RankBeat> beats(static_cast<std::size_t>(size_));
+  const double stepped = unix_seconds() - waited;
+  const auto file_of = [this](int r) { return folder_ / fmt::format("rank-{}", r); };
+  // A rank counts as alive only once its file changes while this one waits: a file that merely
+  // looks recent can belong to a rank stopped a moment ago (its stamp is younger than the stale
+  // limit when the timeout is short). A rank whose file is already stale, or that stays
+  // unchanged for two periods and a second, is silent. Comparing stamps of one rank with each
+  // other, not with this node's clock, keeps the test free of clock skew between nodes.
+  std::vector<RankBeat> first(static_cast<std::size_t>(size_)), beats(first.size());
+  std::vector<char> decided(first.size(), 0);
+  const double start = unix_seconds();
+  for (int r = 0; r < size_; ++r) {
+    if (r == rank_) {
+      decided[r] = 1;
+      continue;
+    }
+    first[r] = beats[r] = read_beat(file_of(r));
+    if (first[r].found && start - first[r].alive > stale_after(period)) decided[r] = 1;
+  }
+  const double patience = 2.0 * period + 1.0;
+  const double begun = steady_seconds();
+  double written = begun;
+  while (std::find(decided.begin(), decided.end(), 0) != decided.end() && steady_seconds() - begun < patience) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(0.1, period / 4.0)));
+    if (steady_seconds() - written >= period) {  // the other ranks wait on this one's file too
+      write_own_file(step, stepped);
+      written = steady_seconds();
+    }
+    for (int r = 0; r < size_; ++r) {
+      if (decided[r]) continue;
+      const RankBeat b = read_beat(file_of(r));
+      if (b.found && (!first[r].found || b.alive != first[r].alive)) {
+        beats[r] = b;
+        decided[r] = 2;  // wrote again: alive
+      }
+    }
+  }
+  const double now = unix_seconds();
   std::vector<int> silent, alive;
   for (int r = 0; r < size_; ++r) {
-    beats[r] = r == rank_ ? RankBeat{true, step, now, now - waited}
-                          : read_beat(folder_ / fmt::format("rank-{}", r));
-    (beats[r].found && now - beats[r].alive <= stale_after(period) ? alive : silent).push_back(r);
+    if (r == rank_) beats[r] = RankBeat{true, step, now, stepped};
+    (r == rank_ || decided[r] == 2 ? alive : silent).push_back(r);
   }
   // One message: from the lowest-numbered rank that still runs (the others end quietly).
   if (alive.empty() || alive.front() != rank_) return {};
