@@ -6,6 +6,7 @@
 // rigid motion and uniform stress giving no spurious deformation or interior force).
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -14,6 +15,7 @@
 #include "cairn/sim/simulation.hpp"
 #include "cairn/wls/arrangement.hpp"
 #include "cairn/wls/cut_cell.hpp"
+#include "cairn/wls/grid_stencil.hpp"
 #include "cairn/wls/integrator.hpp"
 #include "cairn/wls/least_squares.hpp"
 #include "cairn/wls/weights.hpp"
@@ -712,6 +714,79 @@ TEST(WlsIntegration, AccelerationFilterPassesLinearFieldsAndDampsZigZag) {
   EXPECT_EQ(before, 1.0);
   EXPECT_GT(uniform, 20);
   EXPECT_LT(after, 0.25 + 1e-12);
+}
+
+template <int D>
+void check_hourglass_damping() {
+  // method.hourglass_damping (docs/wls.md, departure 13): a linear grid velocity (rigid motion,
+  // uniform strain rate) passes unchanged at every node, any velocity keeps its momentum, and a
+  // node-scale checkerboard of each corner pattern loses the fraction kappa of its amplitude at
+  // nodes whose 3^D block carries one mass.
+  Simulation<D> sim(wls_config(D, "circle", 0.05));
+  const auto& grid = sim.grid();
+  const double kappa = 0.3;
+  wls::Options o;
+  o.hourglass_damping = kappa;
+  wls::Integrator<D> damper(grid, o);
+  NodeField<D> nodes = sim.nodes();
+  Vec<D> c0;
+  Eigen::Matrix<double, D, D> A;
+  for (int a = 0; a < D; ++a) {
+    c0[a] = 0.3 - 0.2 * a;
+    for (int b = 0; b < D; ++b) A(a, b) = 0.7 * (a == b) + 0.4 * (b - a) + 0.1 * a * b;  // rotation + strain
+  }
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) nodes.velocity_new[i] = c0 + A * grid.node_position(i);
+  damper.damp_hourglass(grid, nodes);
+  int with_mass = 0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    if (!(nodes.mass[i] > 0.0)) continue;
+    ++with_mass;
+    EXPECT_NEAR((nodes.velocity_new[i] - c0 - A * grid.node_position(i)).norm(), 0.0, 1e-12) << i;
+  }
+  EXPECT_GT(with_mass, 50);
+  // Momentum of an arbitrary field.
+  Vec<D> before = Vec<D>::Zero(), after = Vec<D>::Zero();
+  double scale = 0.0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    for (int a = 0; a < D; ++a) nodes.velocity_new[i][a] = std::sin(1.7 * i + a) + 0.3 * std::cos(0.37 * i * i);
+    before += nodes.mass[i] * nodes.velocity_new[i];
+    scale += nodes.mass[i] * nodes.velocity_new[i].norm();
+  }
+  damper.damp_hourglass(grid, nodes);
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) after += nodes.mass[i] * nodes.velocity_new[i];
+  EXPECT_LT((after - before).norm(), 1e-13 * scale);
+  // Checkerboards: (-1)^(sum of the pattern's axes' node indices), one pattern per axis set of
+  // two or more axes.
+  for (int axes = 3; axes < (1 << D); ++axes) {
+    if (std::popcount(static_cast<unsigned>(axes)) < 2) continue;
+    const auto sign = [&](std::int32_t i) {
+      const IVec<D> j = grid.multi_index(i);
+      int sum = 0;
+      for (int a = 0; a < D; ++a)
+        if ((axes >> a) & 1) sum += j[a];
+      return sum % 2 ? -1.0 : 1.0;
+    };
+    for (std::int32_t i = 0; i < grid.n_nodes(); ++i) nodes.velocity_new[i] = Vec<D>::Constant(sign(i));
+    damper.damp_hourglass(grid, nodes);
+    int uniform = 0;
+    for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+      if (!(nodes.mass[i] > 0.0)) continue;
+      bool same = true;
+      wls::detail::for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>&) {
+        same = same && std::abs(nodes.mass[nb] - nodes.mass[i]) <= 1e-12 * nodes.mass[i];
+      });
+      if (!same) continue;
+      ++uniform;
+      EXPECT_NEAR((nodes.velocity_new[i] - (1.0 - kappa) * Vec<D>::Constant(sign(i))).norm(), 0.0, 1e-12)
+          << "pattern " << axes << ", node " << i;
+    }
+    EXPECT_GT(uniform, D == 2 ? 20 : 4) << "pattern " << axes;
+  }
+}
+
+TEST(WlsIntegration, HourglassDampingKeepsLinearFieldsAndMomentumAndDampsCheckerboards) {
+  check_hourglass_damping<2>();
+  check_hourglass_damping<3>();
 }
 
 TEST(WlsIntegration, UniformStressGivesNoInteriorForce) {

@@ -68,6 +68,9 @@ struct Options {
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
   /// method.filter_acceleration: the step filters the grid velocity increments (docs/wls.md).
   bool filter_acceleration = false;
+  /// method.hourglass_damping: the fraction of each full cell's hourglass velocity the step
+  /// removes (docs/wls.md); 0 = seed 001 as printed.
+  double hourglass_damping = 0.0;
   /// Particle velocity update: false = Eq. 27 as printed, V_p += sum S_ip (v+_i - v_i) (FLIP);
   /// true = V_p = sum S_ip v+_i (PIC, seed 002 Eq. 1.66 without damping; docs/wls.md).
   bool pic_velocity = false;
@@ -147,6 +150,10 @@ class Integrator {
   /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
   /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.
   void filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes);
+
+  /// v+ less Options::hourglass_damping times the hourglass part of v+ in every cell whose
+  /// corners all carry mass (momentum kept; docs/wls.md); the caller imposes the conditions again.
+  void damp_hourglass(const Grid<D>& grid, NodeField<D>& nodes);
 
   // ---- inspection (tests, snapshots) ----------------------------------------------------------
   [[nodiscard]] const std::vector<double>& signed_distance() const { return distance_; }

@@ -16,6 +16,7 @@ Options options(const MethodConfig& method) {
   o.extrapolated_spurious_velocity = method.plugin.text("spurious_velocity") == "neighbours";
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
+  o.hourglass_damping = method.plugin.real("hourglass_damping");
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
   o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
   return o;
@@ -66,6 +67,14 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "and the node-to-node zig-zag of small cut cells does not (docs/wls.md; not "
       "energy conserving); false = seed 001 as printed.")
       .by_default("false"),
+    Key("", "hourglass_damping", KeyType::real,
+      "WLS hourglass damping: the fraction of a node-scale checkerboard of the grid "
+      "velocity removed each step, applied in every cell whose corners all carry mass to the "
+      "corner patterns orthogonal to linear fields, momentum kept; 0 = seed 001 as printed, "
+      "whose one-point cell integration leaves that mode unresisted (docs/wls.md).")
+      .by_default("0.0")
+      .min(0.0)
+      .max(1.0),
     Key("", "particle_velocity", KeyType::string,
       "WLS particle velocity update: flip = V_p += sum S_ip (v+_i - v_i) (seed 001 Eq. 27 "
       "as printed); pic = V_p = sum S_ip v+_i (seed 002 Eq. 1.66), which keeps the "

@@ -18,6 +18,10 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
     wls.filter_acceleration(grid, nodes);
     engine.impose_end_conditions();
   }
+  if (wls.options().hourglass_damping > 0.0) {
+    wls.damp_hourglass(grid, nodes);
+    engine.impose_end_conditions();
+  }
   engine.lap(2);
   wls.move_particles(grid, nodes, particles, dt);  // Eq. 27-29 (or the quadrature gradient)
   engine.lap(4);
