@@ -23,10 +23,10 @@ constexpr double E = 1.0e6;
 /// A WLS bar [0, L] x [0.275, 0.525] (x [0.275, 0.525] in 3D) on the grid [0, 1]^D, linear
 /// elastic with nu = 0 (plane strain: sigma_xx = E eps_xx, sigma_yy = 0 for a free strip),
 /// h = 0.05, 2 ppc: its faces lie halfway between node lines (x = L = 0.425 below).
-Config bar_config(int D, double L, bool held) {
+Config bar_config(int D, double L, bool held, double h = 0.05) {
   Config c = test::box_config(D, "linear");
   c.method.integration = "wls";
-  c.grid.cell_size.assign(D, 0.05);
+  c.grid.cell_size.assign(D, h);
   c.materials[0].numbers["poissons_ratio"] = 0.0;
   auto& b = c.bodies[0];
   b.shape.min.assign(D, 0.275);
@@ -78,9 +78,9 @@ struct HeldBar {
 /// `transits` wave transits L / c and then held for eight more; the particles with X < 0.3
 /// sampled over the last four transits (one period of the bar's fundamental mode).
 template <int D>
-HeldBar held_bar(double L, double lo, double hi, double transits) {
+HeldBar held_bar(double L, double lo, double hi, double transits, double h = 0.05) {
   constexpr double T = 1.0e3;
-  Config c = bar_config(D, L, true);
+  Config c = bar_config(D, L, true, h);
   for (int a = 1; a < D; ++a) {
     c.bodies[0].shape.min[a] = lo;
     c.bodies[0].shape.max[a] = hi;
@@ -122,8 +122,8 @@ HeldBar held_bar(double L, double lo, double hi, double transits) {
     ++n;
   }
   result.scatter = std::sqrt(sq / n);
-  std::printf("held bar %dD, x in [0, %g], y in [%g, %g], ramp %g transits: mean sigma_xx / T = %.4f, oscillation "
-              "+-%.4f, particle scatter (rms) %.4f; integrated cross-section / the bar's %.4f\n", D, L, lo, hi,
+  std::printf("held bar %dD, h = %g, x in [0, %g], y in [%g, %g], ramp %g transits: mean sigma_xx / T = %.4f, oscillation "
+              "+-%.4f, particle scatter (rms) %.4f; integrated cross-section / the bar's %.4f\n", D, h, L, lo, hi,
               transits, result.mean, result.oscillation, result.scatter, result.section);
   return result;
 }
@@ -154,6 +154,24 @@ TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStress3D) {
     EXPECT_LT(r.section, 1.0);
     EXPECT_LT(r.oscillation, 0.02) << at.L << " " << at.lo;
   }
+}
+
+// The 3D held bar on finer grids (label `long`, ctest wls.traction_refinement; about 2 min):
+// the integrated body's section loses the rounded edges, O(h^2), so the section deficit falls by
+// about 4 from h = 0.05 to 0.025 and the mean stress tends to T, while the load stays T A.
+TEST(WlsLong, DISABLED_TractionOnAHeldBarConvergesIn3D) {
+  const HeldBar coarse = held_bar<3>(0.45, 0.25, 0.55, 10.0, 0.05);
+  const HeldBar fine = held_bar<3>(0.45, 0.25, 0.55, 10.0, 0.025);
+  for (const HeldBar& r : {coarse, fine}) {
+    EXPECT_NEAR(r.mean * r.section, 1.0, 0.01);  // the force T A
+    EXPECT_LT(r.oscillation, 0.02);
+  }
+  const double order = std::log2((1.0 - coarse.section) / (1.0 - fine.section));
+  std::printf("section deficit %.4f -> %.4f (order %.2f), mean sigma_xx / T - 1: %.4f -> %.4f\n",
+              1.0 - coarse.section, 1.0 - fine.section, order, coarse.mean - 1.0, fine.mean - 1.0);
+  EXPECT_GT(order, 1.6);
+  EXPECT_LT(std::abs(fine.mean - 1.0), 0.4 * std::abs(coarse.mean - 1.0));
+  // The particles' scatter does not fall with h in 3D (0.099, 0.106; docs/wls.md): not asserted.
 }
 
 template <int D>
