@@ -109,6 +109,19 @@ TEST(Robustness, DamagedCheckpointIsRefusedByItsChecksum) {
   EXPECT_TRUE(input_error(cairn("restart time.h5 -q", d), "time.h5", "checksum"));
 }
 
+TEST(Robustness, FailureReportNamesTheParticleWhereItIsAndWhatFailed) {
+  // A neo-Hookean block squeezed so hard that F inverts within a few steps (docs/output.md).
+  const fs::path d = case_dir("failure_names");
+  std::string input = base_input();
+  input.replace(input.find("linear_elastic"), std::string("linear_elastic").size(), "neo_hookean");
+  const CliResult r = cairn_on("run", input + "velocity = [\"-1000 * (X - 0.5)\", 0.0]\n", d,
+                               "-q --set simulation.dt=2e-3 --set output.directory='\"out\"'");
+  ASSERT_EQ(r.code, 3) << r.output;
+  EXPECT_TRUE(std::regex_search(
+      r.output, std::regex("particle [0-9]+ \\(body 0, at \\([0-9.e+-]+, [0-9.e+-]+\\)\\): det F = -?[0-9.e+-]+;")))
+      << r.output;
+}
+
 TEST(Robustness, FailureReportHasSignificantDigitsAndItsOwnStep) {
   const fs::path d = case_dir("failure");
   // A block squeezed at 20 m/s with a time step far above the stable one (about 1.4e-3).

@@ -2,6 +2,8 @@
 // F and the material stress, with the failure checks of every particle.
 #include "cairn/sim/simulation_detail.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -249,9 +251,17 @@ void Simulation<D>::particle_failure(std::int64_t first_bad, const std::string& 
   std::string value;
   if (what == "det F") value = "det F = " + failure_number(particles_.deformation_gradient[p].determinant());
   else value = what + " is not finite";
-  throw SimulationFailure(first_bad, what,
-                          "particle " + std::to_string(first_bad) + " (body " +
-                              std::to_string(particles_.body[p]) + "): " + value);
+  std::string where = fmt::format("body {}, at ({:.6g})", particles_.body[p], fmt::join(particles_.position[p], ", "));
+  if (wls_ && wls::is_surface(particles_, p)) {
+    // A WLS surface particle carries no mass: say whether it has left the body (docs/wls.md).
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < particles_.n(); ++k)
+      if (!wls::is_surface(particles_, k))
+        nearest = std::min(nearest, (particles_.position[k] - particles_.position[p]).norm());
+    where += fmt::format("; a WLS surface particle (zero volume), {:.3g} cells from the nearest particle with volume",
+                         nearest / grid_.min_cell_size());
+  }
+  throw SimulationFailure(first_bad, what, "particle " + std::to_string(first_bad) + " (" + where + "): " + value);
 }
 
 #define CAIRN_INSTANTIATE(D) \
