@@ -1,12 +1,12 @@
 // The loads and corrections the WLS integrator applies at the nodes after its sums: the
-// tractions' spread over the cut-cell surface (docs/wls.md, departure 10) and the opt-in
-// acceleration filter.
+// tractions' spread over the cut-cell surface (docs/wls.md, departure 10), the opt-in
+// acceleration filter and the opt-in hourglass damping (departure 13).
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <limits>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/wls/grid_stencil.hpp"
@@ -106,10 +106,10 @@ void Integrator<D>::damp_hourglass(const Grid<D>& grid, NodeField<D>& nodes) {
   // and +1 at the upper corner along a, over every axis set A of two or more axes: one pattern in
   // 2D, four in 3D. They are orthogonal to every linear field, so a rigid motion or a uniform
   // strain rate loses nothing. Seed 001 Sec. 3.4.2 expects no zero-energy mode of its one-point
-  // cell integration; measured, this mode goes unresisted (docs/wls.md, departure 13). Per cell
-  // whose 2^D corners carry mass and per pattern,
-  // q = sum_k Gamma_k v+_k / 2^D and corner k receives the momentum -kappa m_min Gamma_k q
-  // (sum_k Gamma_k = 0: the cell's momentum is kept); gathered per node, race-free. With
+  // cell integration; measured, this mode goes unresisted (docs/wls.md, departure 13).
+  // Per cell whose 2^D corners carry mass and per pattern, q = sum_k Gamma_k v+_k / 2^D, and
+  // corner k receives the momentum -kappa m_min Gamma_k q (sum_k Gamma_k = 0: the cell's
+  // momentum is kept; m_min is the cell's smallest corner mass); gathered per node, race-free. With
   // kappa = hourglass_damping / 2^D, a node-scale checkerboard of one pattern on nodes of equal
   // mass loses the fraction hourglass_damping of its amplitude per step (each of a node's 2^D
   // cells takes kappa of it), and a linear field nothing.
