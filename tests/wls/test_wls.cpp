@@ -716,19 +716,27 @@ TEST(WlsIntegration, AccelerationFilterPassesLinearFieldsAndDampsZigZag) {
   EXPECT_LT(after, 0.25 + 1e-12);
 }
 
+/// What method.hourglass_damping does to three grid velocities (docs/wls.md, departure 13).
+struct HourglassMeasure {
+  int with_mass = 0;                  ///< nodes with mass
+  double linear_change = 0.0;         ///< largest change of a linear field at a node with mass
+  double momentum_change = 0.0;       ///< |change of sum m v| / sum m |v| for an arbitrary field
+  double checkerboard_error = 0.0;    ///< largest |v_after - (1 - kappa) v_before| of a checkerboard
+  int uniform_nodes = 1 << 30;        ///< fewest nodes of one mass block, over the patterns
+};
+
 template <int D>
-void check_hourglass_damping() {
-  // method.hourglass_damping (docs/wls.md, departure 13): a linear grid velocity (rigid motion,
-  // uniform strain rate) passes unchanged at every node, any velocity keeps its momentum, and a
-  // node-scale checkerboard of each corner pattern loses the fraction kappa of its amplitude at
-  // nodes whose 3^D block carries one mass.
+HourglassMeasure measure_hourglass_damping(double kappa) {
+  // A linear grid velocity (rigid motion, uniform strain rate), an arbitrary one (momentum), and a
+  // node-scale checkerboard of each corner pattern, measured at nodes whose 3^D block carries one
+  // mass.
   Simulation<D> sim(wls_config(D, "circle", 0.05));
   const auto& grid = sim.grid();
-  const double kappa = 0.3;
   wls::Options o;
   o.hourglass_damping = kappa;
   wls::Integrator<D> damper(grid, o);
   NodeField<D> nodes = sim.nodes();
+  HourglassMeasure out;
   Vec<D> c0;
   Eigen::Matrix<double, D, D> A;
   for (int a = 0; a < D; ++a) {
@@ -737,14 +745,11 @@ void check_hourglass_damping() {
   }
   for (std::int32_t i = 0; i < grid.n_nodes(); ++i) nodes.velocity_new[i] = c0 + A * grid.node_position(i);
   damper.damp_hourglass(grid, nodes);
-  int with_mass = 0;
   for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
     if (!(nodes.mass[i] > 0.0)) continue;
-    ++with_mass;
-    EXPECT_NEAR((nodes.velocity_new[i] - c0 - A * grid.node_position(i)).norm(), 0.0, 1e-12) << i;
+    ++out.with_mass;
+    out.linear_change = std::max(out.linear_change, (nodes.velocity_new[i] - c0 - A * grid.node_position(i)).norm());
   }
-  EXPECT_GT(with_mass, 50);
-  // Momentum of an arbitrary field.
   Vec<D> before = Vec<D>::Zero(), after = Vec<D>::Zero();
   double scale = 0.0;
   for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
@@ -754,9 +759,8 @@ void check_hourglass_damping() {
   }
   damper.damp_hourglass(grid, nodes);
   for (std::int32_t i = 0; i < grid.n_nodes(); ++i) after += nodes.mass[i] * nodes.velocity_new[i];
-  EXPECT_LT((after - before).norm(), 1e-13 * scale);
-  // Checkerboards: (-1)^(sum of the pattern's axes' node indices), one pattern per axis set of
-  // two or more axes.
+  out.momentum_change = (after - before).norm() / scale;
+  // Checkerboards: (-1)^(sum of the pattern's axes' node indices), one per axis set of two or more.
   for (int axes = 3; axes < (1 << D); ++axes) {
     if (std::popcount(static_cast<unsigned>(axes)) < 2) continue;
     const auto sign = [&](std::int32_t i) {
@@ -777,16 +781,24 @@ void check_hourglass_damping() {
       });
       if (!same) continue;
       ++uniform;
-      EXPECT_NEAR((nodes.velocity_new[i] - (1.0 - kappa) * Vec<D>::Constant(sign(i))).norm(), 0.0, 1e-12)
-          << "pattern " << axes << ", node " << i;
+      out.checkerboard_error = std::max(
+          out.checkerboard_error, (nodes.velocity_new[i] - (1.0 - kappa) * Vec<D>::Constant(sign(i))).norm());
     }
-    EXPECT_GT(uniform, D == 2 ? 20 : 4) << "pattern " << axes;
+    out.uniform_nodes = std::min(out.uniform_nodes, uniform);
   }
+  return out;
 }
 
 TEST(WlsIntegration, HourglassDampingKeepsLinearFieldsAndMomentumAndDampsCheckerboards) {
-  check_hourglass_damping<2>();
-  check_hourglass_damping<3>();
+  // method.hourglass_damping (docs/wls.md, departure 13): linear fields pass unchanged, momentum
+  // is kept, and a checkerboard of each corner pattern loses the fraction kappa per step.
+  for (const HourglassMeasure& m : {measure_hourglass_damping<2>(0.3), measure_hourglass_damping<3>(0.3)}) {
+    EXPECT_GT(m.with_mass, 50);
+    EXPECT_LT(m.linear_change, 1e-12);
+    EXPECT_LT(m.momentum_change, 1e-13);
+    EXPECT_LT(m.checkerboard_error, 1e-12);
+    EXPECT_GT(m.uniform_nodes, 4);
+  }
 }
 
 TEST(WlsIntegration, UniformStressGivesNoInteriorForce) {
