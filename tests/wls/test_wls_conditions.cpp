@@ -305,6 +305,61 @@ TEST(WlsConditions, MovingWallCompressesAHeldBar) {
   EXPECT_NEAR(syy / expected, 0.0, 0.02);
 }
 
+// ---- a body landing on a frictionless wall -------------------------------------------------------
+
+/// A strip [0, 0.25] x [0.11, 0.41] across the periodic x axis (a 1D problem) falling at v0 = 0.2
+/// onto the symmetry face y = 0, which it does not reach at the start (the walls of seed 001
+/// Sec. 5.2); neo-Hookean as the disk impact (E = 1000, nu = 0.3, rho0 = 1000), h = 0.025, 2 ppc,
+/// central differences, CFL 0.4. Returns the largest speed into the wall of any particle row
+/// (mean over the row's particles with volume) until t = 0.7, in units of v0. In the exact
+/// solution no part of the strip moves faster than v0: the wall stops the rows nearest to it
+/// first (docs/wls.md, departure 14).
+double fastest_row_into_the_wall(const std::string& mirror_planes) {
+  constexpr double v0 = 0.2;
+  Config c = test::box_config(2, "linear", "neo_hookean");
+  c.method.integration = "wls";
+  c.method.time_integration = "central_difference";
+  c.method.plugin.set("mirror_planes", mirror_planes);
+  c.materials[0].numbers["youngs_modulus"] = 1000.0;
+  c.grid.extent = {0.25, 1.0};
+  c.grid.cell_size.assign(2, 0.025);
+  c.boundary.face[0] = c.boundary.face[1] = FaceCondition::periodic;
+  c.boundary.face[2] = c.boundary.face[3] = FaceCondition::symmetry;
+  auto& b = c.bodies[0];
+  b.shape.min = {0.0, 0.11};
+  b.shape.max = {0.25, 0.41};
+  b.velocity = {"0", "-0.2"};
+  Simulation<2> sim(c);
+  const auto& P = sim.particles();
+  double fastest = 0.0;
+  while (sim.time() < 0.7) {
+    sim.step(sim.next_dt());
+    std::map<long long, std::pair<double, int>> rows;  // reference y (in 1e-6) -> sum v_y, count
+    for (std::size_t p = 0; p < P.n(); ++p) {
+      if (wls::is_surface(P, p)) continue;
+      auto& r = rows[std::llround(P.reference_position[p][1] * 1e6)];
+      r.first += P.velocity[p][1];
+      ++r.second;
+    }
+    for (const auto& [y, r] : rows) fastest = std::max(fastest, -r.first / r.second / v0);
+  }
+  return fastest;
+}
+
+TEST(WlsConditions, BodyLandingOnAWallSlowsFromTheWallUp) {
+  // With the wall's nodes held while the strip's surface is still up to a cell away, the cut
+  // cell between the wall and the first node row holds a sliver of the strip whose small volume
+  // cannot pass the wall's reaction to that row (Eq. 24): the row is pushed on towards the wall
+  // by the cell above it and the rows nearest the wall speed up past v0 (measured 1.086 v0).
+  // With the wall a mirror plane (method.mirror_planes = "all") the strip meets its image at the
+  // wall and the nearest rows stop first (measured 1.000 v0; cpGIMP 1.008 v0).
+  const double reached = fastest_row_into_the_wall("reached");
+  const double all = fastest_row_into_the_wall("all");
+  std::printf("fastest row into the wall / v0: mirror_planes = reached %.4f, all %.4f\n", reached, all);
+  EXPECT_GT(reached, 1.05);
+  EXPECT_LT(all, 1.01);
+}
+
 // ---- periodic axes ------------------------------------------------------------------------------
 
 /// A box body of the WLS bar's material, as two boxes when it crosses x = 1 (the seam of the

@@ -261,10 +261,13 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
       throw std::invalid_argument(config_.tractions.front().where.str() + ": [[traction]] under method.integration = "
                                   "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default; "
                                   "docs/wls.md)");
-    // A symmetry face is a mirror plane of the body when the body reaches it at the start
-    // (a particle within half a cell); otherwise it is a frictionless wall (docs/wls.md).
+    // Every symmetry face is a mirror plane of the body (method.mirror_planes = "all", the
+    // default: a body landing on a frictionless wall meets its mirror image there); with
+    // "reached" only a face the body reaches at the start (a particle within half a cell), the
+    // others being held like any grid face (docs/wls.md, departure 14).
     for (int f = 0; f < 2 * D; ++f) {
       if (config_.boundary.face[f] != FaceCondition::symmetry) continue;
+      o.mirror[f] = o.every_symmetry_face_mirrors;
       const int a = f / 2;
       const double plane = f % 2 ? grid_.extent_max()[a] : grid_.origin()[a];
       for (std::size_t p = 0; p < particles_.n() && !o.mirror[f]; ++p)

@@ -58,9 +58,14 @@ struct Options {
   /// fits evaluated at the node (linear fields reproduced); false = its constant fit c0 (Sec. 3.5
   /// as printed: a weighted mean of particle velocities about a cell away).
   bool extrapolated_spurious_velocity = false;
-  /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches): node
-  /// flags count the mirror image and surface positions of nodes on it lie in it.
+  /// Face 2*axis + side is a mirror plane of the body (a symmetry face the body reaches, or with
+  /// every_symmetry_face_mirrors any symmetry face): node flags count the mirror image and
+  /// surface positions of nodes on it lie in it.
   std::array<bool, 6> mirror{};
+  /// method.mirror_planes = "all": every symmetry face is a mirror plane, also one the body
+  /// meets later (a frictionless wall: the body meets its mirror image there; docs/wls.md,
+  /// departure 14); false = only faces the body reaches at the start.
+  bool every_symmetry_face_mirrors = true;
   /// Particle velocity gradient: true = from the integration points (sum_k v+_k (x) G_kq at each
   /// region, S V-averaged to the nodes, S-interpolated to the particle; docs/wls.md); false =
   /// Eq. 29 as printed (sum_i v+_i (x) G_ip), unstable at free surfaces in our runs.

@@ -19,6 +19,7 @@ Options options(const MethodConfig& method) {
   o.hourglass_damping = method.plugin.real("hourglass_damping");
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
   o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
+  o.every_symmetry_face_mirrors = method.plugin.text("mirror_planes") == "all";
   return o;
 }
 
@@ -75,6 +76,14 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       .by_default("0.0")
       .min(0.0)
       .max(1.0),
+    Key("", "mirror_planes", KeyType::string,
+      "WLS symmetry faces whose nodes count the body's mirror image in the surface flags "
+      "and distances: all = every symmetry face, so that a body that lands on a frictionless "
+      "wall meets its mirror image there and the wall's reaction reaches it; reached = only "
+      "the faces the body reaches at the start (a quarter model), a wall's nodes are then "
+      "held while the body is still up to a cell away (docs/wls.md).")
+      .by_default("\"all\"")
+      .choices([] { return std::vector<std::string>{"reached", "all"}; }),
     Key("", "particle_velocity", KeyType::string,
       "WLS particle velocity update: flip = V_p += sum S_ip (v+_i - v_i) (seed 001 Eq. 27 "
       "as printed); pic = V_p = sum S_ip v+_i (seed 002 Eq. 1.66), which keeps the "
