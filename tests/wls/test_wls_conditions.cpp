@@ -360,6 +360,40 @@ TEST(WlsConditions, BodyLandingOnAWallSlowsFromTheWallUp) {
   EXPECT_LT(all, 1.01);
 }
 
+TEST(WlsConditions, EmptyWallCornersKeepTheWallsVelocity) {
+  // A surface particle 0.3 h above a wall, in a cell whose corners on the wall carry no mass and
+  // whose upper corners (with mass) move at v+ = (0.3, -1), from rest. The empty corners take
+  // the mean of the corners with mass (empty_corners = "mean", docs/wls.md departure 12) except
+  // in the components the wall's condition set (held: the normal one, zero): the particle takes
+  // 0.3 of the normal motion, the upper corners' share of S, and all of the tangential one.
+  // Without the held components it would move on into the wall at the inner corners' speed.
+  Simulation<2> sim(bar_config(2, 0.425, false));
+  const auto& grid = sim.grid();
+  const double h = grid.cell_size()[0];
+  wls::Integrator<2> wls(grid, wls::Options{});
+  Particles<2> start;
+  start.add(Vec<2>(0.51, 0.3 * h), Vec<2>::Zero(), 1.0, 0.0, Vec<2>::Constant(0.5 * h), 0, 0);
+  wls.build_stencils(grid, start);
+  NodeField<2> nodes = sim.nodes();
+  std::vector<std::uint8_t> held(static_cast<std::size_t>(grid.n_nodes()), 0);
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    const double y = grid.node_position(i)[1];
+    const bool above = y > 0.5 * h;
+    nodes.mass[i] = above ? 1.0 : 0.0;
+    nodes.velocity[i] = Vec<2>::Zero();
+    nodes.velocity_new[i] = above ? Vec<2>(0.3, -1.0) : Vec<2>::Zero();
+    if (std::abs(y) < 1e-12) held[i] = 0b10;  // the floor's symmetry condition: v_y = 0
+  }
+  const double dt = 1e-3;
+  Particles<2> free = start, walled = start;
+  wls.move_particles(grid, nodes, free, dt);
+  wls.move_particles(grid, nodes, walled, dt, &held);
+  EXPECT_NEAR((free.velocity[0] - Vec<2>(0.3, -1.0)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((walled.velocity[0] - Vec<2>(0.3, -0.3)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR(walled.position[0][1] - start.position[0][1], -0.3 * dt, 1e-15);
+  EXPECT_NEAR(walled.position[0][0] - start.position[0][0], 0.3 * dt, 1e-15);
+}
+
 // ---- periodic axes ------------------------------------------------------------------------------
 
 /// A box body of the WLS bar's material, as two boxes when it crosses x = 1 (the seam of the

@@ -616,13 +616,14 @@ void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<
 
 template <int D>
 void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles,
-                                   double dt) {
+                                   double dt, const std::vector<std::uint8_t>* held) {
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
   const auto& mass = nodes.mass;
   const bool from_quadrature = options_.quadrature_gradient;
   const bool pic = options_.pic_velocity;
   const bool all_nodes = options_.massless_corners_included;
+  if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
   gather(cache_, [&](std::int64_t p, const auto&) {
@@ -661,10 +662,14 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       // summed over it lose the partition of unity, and a rigid translation would slow such a
       // particle down (and then, through the next fits, its neighbours). Such a corner takes the
       // S-weighted mean of the corners with mass: Eq. 27-28 over the corners with mass, divided
-      // by their sum of S (docs/wls.md, departure 12). Eq. 29 is left as printed (measured in
-      // docs/wls.md: the same mean there made plate_hole scatter more).
-      Vec<D> dv_m = Vec<D>::Zero(), vx_m = Vec<D>::Zero();
-      double S_m = 0.0;
+      // by their sum of S (docs/wls.md, departure 12). A component that a velocity condition set
+      // keeps the condition's value (a wall's zero normal velocity), so that a particle next to a
+      // wall does not take the inner corners' motion into it. Eq. 29 is left as printed (measured
+      // in docs/wls.md: the same mean there made plate_hole scatter more).
+      Vec<D> dv_m = Vec<D>::Zero(), vx_m = Vec<D>::Zero();  // over the corners with mass
+      Vec<D> dv_h = Vec<D>::Zero(), vx_h = Vec<D>::Zero();  // over held components without mass
+      Vec<D> S_h = Vec<D>::Zero();
+      double S_m = 0.0, S_all = 0.0;
       for_each_slot<D>([&](const std::array<int, D>& k) {
         std::int32_t i = 0;
         double S = 1.0;
@@ -672,14 +677,26 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
           i += axis_node[3 * a + k[a]];
           S *= axis_S[6 * a + k[a]];
         }
-        if (!(mass[i] > 0.0)) return;
-        S_m += S;
-        dv_m += S * (v_new[i] - v[i]);
-        vx_m += S * v_new[i];
+        S_all += S;
+        if (mass[i] > 0.0) {
+          S_m += S;
+          dv_m += S * (v_new[i] - v[i]);
+          vx_m += S * v_new[i];
+        } else if (held && S != 0.0) {
+          for (int a = 0; a < D; ++a)
+            if ((*held)[i] >> a & 1U) {
+              S_h[a] += S;
+              dv_h[a] += S * (v_new[i][a] - v[i][a]);
+              vx_h[a] += S * v_new[i][a];
+            }
+        }
       });
       if (S_m > 0.0) {
-        dv = dv_m / S_m;
-        vx = vx_m / S_m;
+        for (int a = 0; a < D; ++a) {
+          const double free = S_h[a] == 0.0 ? 1.0 : (S_all - S_h[a]);  // S of the corners taking the mean
+          dv[a] = dv_m[a] / S_m * free + dv_h[a];
+          vx[a] = vx_m[a] / S_m * free + vx_h[a];
+        }
       }
     }
     if (from_quadrature && weight > 0.0) L /= weight;

@@ -149,8 +149,10 @@ class Integrator {
   /// Eq. 27-29 from v = nodes.velocity and v+ = nodes.velocity_new: V += S (v+ - v) (or, with
   /// Options::pic_velocity, V = S v+), x += S v+ dt, and the velocity gradient into particle_velocity_gradient(): Eq. 29
   /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
-  /// integration points' gradients.
-  void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt);
+  /// integration points' gradients. `held` (per node, bit a: a velocity condition set component
+  /// a; null: none) keeps the conditions' values at corners without mass (departure 12).
+  void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
+                      const std::vector<std::uint8_t>* held = nullptr);
 
   /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
   /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.

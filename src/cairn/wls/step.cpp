@@ -23,7 +23,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
     engine.impose_end_conditions();
   }
   engine.lap(2);
-  wls.move_particles(grid, nodes, particles, dt);  // Eq. 27-29 (or the quadrature gradient)
+  // Eq. 27-29 (or the quadrature gradient)
+  wls.move_particles(grid, nodes, particles, dt, &engine.held_components());
   engine.lap(4);
   engine.update_materials(wls.particle_velocity_gradient(), dt);  // Eq. 30
   engine.lap(5);
