@@ -261,6 +261,9 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
       throw std::invalid_argument(config_.tractions.front().where.str() + ": [[traction]] under method.integration = "
                                   "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default; "
                                   "docs/wls.md)");
+    if (o.adjoint_point_stress && !o.quadrature_gradient)
+      throw std::invalid_argument("method.point_values = \"adjoint\" needs method.velocity_gradient = "
+                                  "\"quadrature\" (the default): it is that gradient's transpose (docs/wls.md)");
     // Every symmetry face is a mirror plane of the body (method.mirror_planes = "all", the
     // default: a body landing on a frictionless wall meets its mirror image there); with
     // "reached" only a face the body reaches at the start (a particle within half a cell), the

@@ -260,7 +260,69 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
+  if (options_.adjoint_point_stress) adjoint_point_stress(grid, particles);
   integrate(grid, body_force, nodes, node_body_force, surface_loads);
+}
+
+template <int D>
+void Integrator<D>::adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles) {
+  // The quadrature gradient gives particle p the velocity gradient
+  //   L_p = sum_k (S_kp / s_p) sum_q S_kq V_q L_q / W_k,  W_k = sum_q S_kq V_q,
+  // s_p = sum of S_kp over the corners with W_k > 0 (quadrature_gradients, move_particles).
+  // The stress power of the particles, sum_p V_p sigma_p : L_p, is then sum_q V_q sigma_q : L_q
+  // exactly when sigma_q = sum_k S_kq N_k / W_k with N_k = sum_p S_kp V_p sigma_p / s_p: the
+  // transpose of that transfer. With it the internal force of Eq. 24, whose power is
+  // -sum_q V_q sigma_q : L_q, takes from the grid what the particles store (docs/wls.md,
+  // departure 15). V_p sigma_p = V0_p tau_p.
+  const std::int32_t n_nodes = grid.n_nodes();
+  node_volume_.resize(n_nodes);
+  node_stress_power_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    double w = 0.0;
+    for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>&) { w += S * q.volume; });
+    node_volume_[i] = w;
+    node_stress_power_[i].setZero();
+  });
+  scatter(cache_, [&](std::int32_t p, const auto&) {
+    const std::size_t q = static_cast<std::size_t>(p) * D * 3;
+    const std::int32_t* axis_node = &cache_.axis_node[q];
+    const double* axis_S = &cache_.axis_value[2 * q];
+    auto node_and_S = [&](const std::array<int, D>& k, std::int32_t& i, double& S) {
+      i = 0;
+      S = 1.0;
+      for (int a = 0; a < D; ++a) {
+        i += axis_node[3 * a + k[a]];
+        S *= axis_S[6 * a + k[a]];
+      }
+    };
+    double s_p = 0.0;
+    for_each_slot<D>([&](const std::array<int, D>& k) {
+      std::int32_t i;
+      double S;
+      node_and_S(k, i, S);
+      if (node_volume_[i] > 0.0) s_p += S;
+    });
+    if (!(s_p > 0.0) || particles.volume0[p] == 0.0) return;
+    const Eigen::Matrix<double, D, D> tau =
+        particles.kirchhoff_stress[p].full().template topLeftCorner<D, D>() * (particles.volume0[p] / s_p);
+    for_each_slot<D>([&](const std::array<int, D>& k) {
+      std::int32_t i;
+      double S;
+      node_and_S(k, i, S);
+      if (node_volume_[i] > 0.0 && S != 0.0) node_stress_power_[i] += S * tau;
+    });
+  });
+  const auto n_regions = static_cast<std::int64_t>(regions_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t r = 0; r < n_regions; ++r) {
+    const Corners& corner = corners_[r];
+    Eigen::Matrix<double, D, D> sigma = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) {
+      const std::int32_t i = corner.node[k];
+      if (node_volume_[i] > 0.0) sigma += corner.S[k] * node_stress_power_[i] / node_volume_[i];
+    }
+    regions_[r].stress = sigma;
+  }
 }
 
 template <int D>

@@ -54,6 +54,11 @@ struct Options {
   /// fit evaluated at the point (Eq. 10 at r = x_q - x_i), so linear fields are reproduced also
   /// where some corners are spurious; false = the corners' node values c0 (Eq. 19-21 as printed).
   bool fitted_point_values = false;
+  /// Stress at the integration points: true = the transpose of the quadrature gradient's
+  /// transfer (point_values = "adjoint", docs/wls.md departure 15): sigma_q = sum_k S_kq N_k / W_k
+  /// with N_k = sum_p S_kp V_p sigma_p / s_p and W_k = sum_q S_kq V_q, so that the internal
+  /// force's power equals the particles' stress power; density and body force as above.
+  bool adjoint_point_stress = false;
   /// Velocity of a spurious node: true = mean of its well-conditioned neighbours' planar velocity
   /// fits evaluated at the node (linear fields reproduced); false = its constant fit c0 (Sec. 3.5
   /// as printed: a weighted mean of particle velocities about a cell away).
@@ -204,6 +209,7 @@ class Integrator {
   template <class Fn>
   void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;
   void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
+  void adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles);
 
   Options options_;
   Vec<D> h_;
@@ -232,6 +238,8 @@ class Integrator {
   std::vector<double> density_;
   std::vector<Vec<D>> force_density_;
   std::vector<Eigen::Matrix<double, D, D>> stress_;
+  std::vector<Eigen::Matrix<double, D, D>> node_stress_power_;  ///< N_k of adjoint_point_stress
+  std::vector<double> node_volume_;                           ///< W_k of adjoint_point_stress
   std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
   std::vector<double> coef_;           ///< n_nodes x n_fields x n_basis: M^-1 l (Eq. 10), r in cells
   std::vector<std::uint8_t> alpha_;

@@ -13,6 +13,7 @@ Options options(const MethodConfig& method) {
   o.average_per_mass = method.plugin.text("spurious_force") == "per_mass";
   o.integrated_spurious_force = method.plugin.text("spurious_force") == "integrated";
   o.fitted_point_values = method.plugin.text("point_values") == "fit";
+  o.adjoint_point_stress = method.plugin.text("point_values") == "adjoint";
   o.extrapolated_spurious_velocity = method.plugin.text("spurious_velocity") == "neighbours";
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
@@ -46,9 +47,12 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
     Key("", "point_values", KeyType::string,
       "WLS density, body force and stress at the integration points (seed 001 Eq. 19-21): "
       "node = the well-conditioned corners' node values c0 (as printed); fit = their "
-      "planar fits (Eq. 10) evaluated at the point, exact for linear fields (docs/wls.md).")
+      "planar fits (Eq. 10) evaluated at the point, exact for linear fields; adjoint = "
+      "the stress as the transpose of the quadrature gradient's transfer (particles to "
+      "nodes to points), so the internal force takes from the grid the power the "
+      "particles store (docs/wls.md).")
       .by_default("\"node\"")
-      .choices([] { return std::vector<std::string>{"node", "fit"}; }),
+      .choices([] { return std::vector<std::string>{"node", "fit", "adjoint"}; }),
     Key("", "spurious_velocity", KeyType::string,
       "WLS velocity of spurious nodes (seed 001 Sec. 3.5): constant = the reduced fit c0 "
       "(as printed); neighbours = the mean of the well-conditioned neighbours' planar "
