@@ -105,6 +105,36 @@ TEST(VelocityConditions, LaterConditionWinsAndTheRunSaysSoOnce) {
   EXPECT_NEAR(sim.nodes().velocity_new[i][0], 0.5 + 3.0 / std::sqrt(2.0), 1e-12);
 }
 
+TEST(VelocityConditions, HeldComponentsAreReadFromTheConditions) {
+  // What the WLS particle update asks of the conditions (docs/wls.md, departure 12): per node,
+  // the components a condition sets. A symmetry floor sets v_y on its nodes (and, through the
+  // mirror, on the ghost row below); a fixed face sets both components; a node set along an
+  // oblique direction sets both components it has; an axis-aligned one only its own.
+  Simulation<2> sim(load_config_string(
+      bar("[boundary]\ny_min = \"symmetry\"\nx_max = \"fixed\"\n"
+          "[[velocity]]\nplane_axis = \"x\"\nplane_at = 1.0\ndirection = [1.0, 1.0]\nvelocity = 0.5\n"
+          "[[velocity]]\nplane_axis = \"x\"\nplane_at = -1.0\ndirection = [1.0, 0.0]\nvelocity = \"t\"\n"),
+      "b.toml"));
+  sim.step(1e-4);  // the node sets' entries of the step
+  const auto& grid = sim.grid();
+  const auto held = held_components(sim.grid_conditions(), sim.velocity_conditions(), grid.n_nodes());
+  ASSERT_EQ(held.size(), static_cast<std::size_t>(grid.n_nodes()));
+  const auto at = [&](double x, double y) {
+    for (std::int32_t i = 0; i < grid.n_nodes(); ++i)
+      if ((grid.node_position(i) - Vec<2>(x, y)).norm() < 1e-12) return static_cast<int>(held[i]);
+    return -1;
+  };
+  EXPECT_EQ(at(0.0, -0.5), 0b10);   // on the symmetry floor: v_y
+  EXPECT_EQ(at(0.0, 0.0), 0b00);    // inside
+  EXPECT_EQ(at(2.0, 0.25), 0b11);   // on the fixed face
+  EXPECT_EQ(at(1.0, 0.25), 0b11);   // the oblique node set
+  EXPECT_EQ(at(-1.0, 0.25), 0b01);  // the node set along x
+  EXPECT_EQ(at(-1.0, -0.5), 0b11);  // the floor and the node set along x
+  // Without any condition there is nothing to read.
+  Simulation<2> free(load_config_string(bar(""), "b.toml"));
+  EXPECT_TRUE(held_components(free.grid_conditions(), free.velocity_conditions(), free.grid().n_nodes()).empty());
+}
+
 TEST(MovingWall, ControlsInsideNodesWithinDepthAndOutsideNodesWithMass) {
   for (const double depth : {0.5, 1.0, 1.5, 2.0}) {
     Simulation<1> sim(load_config_string(

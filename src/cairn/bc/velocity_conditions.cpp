@@ -161,6 +161,31 @@ void VelocityConditions<D>::take_state(VelocityConditions&& old) {
   comm_ = old.comm_;
 }
 
+template <int D>
+std::vector<std::uint8_t> held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets,
+                                          std::int32_t n_nodes) {
+  std::vector<std::uint8_t> held;
+  if (faces.empty() && sets.empty()) return held;
+  // No value a condition sets is 10^30, and setting a component along a unit direction changes
+  // it (the probe minus its projection plus the value).
+  constexpr double probe = 1.0e30;
+  std::vector<Vec<D>> field(static_cast<std::size_t>(n_nodes), Vec<D>::Constant(probe));
+  faces.apply(field, {}, nullptr, 1.0);
+  sets.apply(field, VelocityConditions<D>::When::end);
+  held.assign(static_cast<std::size_t>(n_nodes), 0);
+  for (std::int32_t i = 0; i < n_nodes; ++i)
+    for (int a = 0; a < D; ++a)
+      if (field[i][a] != probe) held[i] |= static_cast<std::uint8_t>(1U << a);
+  return held;
+}
+
+template std::vector<std::uint8_t> held_components(const GridConditions<1>&, const VelocityConditions<1>&,
+                                                   std::int32_t);
+template std::vector<std::uint8_t> held_components(const GridConditions<2>&, const VelocityConditions<2>&,
+                                                   std::int32_t);
+template std::vector<std::uint8_t> held_components(const GridConditions<3>&, const VelocityConditions<3>&,
+                                                   std::int32_t);
+
 template class VelocityConditions<1>;
 template class VelocityConditions<2>;
 template class VelocityConditions<3>;

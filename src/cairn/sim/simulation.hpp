@@ -165,6 +165,7 @@ class Simulation {
 
   // ---- loads and velocity conditions (docs/boundary-conditions.md) ---------------------------
   /// [[velocity]] node sets and [[wall]] moving walls (names, reactions, wall positions).
+  [[nodiscard]] const GridConditions<D>& grid_conditions() const { return conditions_; }
   [[nodiscard]] const VelocityConditions<D>& velocity_conditions() const { return velocity_conditions_; }
   [[nodiscard]] VelocityConditions<D>& velocity_conditions() { return velocity_conditions_; }
   [[nodiscard]] const Tractions<D>& tractions() const { return tractions_; }

@@ -157,19 +157,7 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     sim_.impose_conditions(sim_.nodes_.velocity_new, VelocityConditions<D>::When::end);
   }
   const std::vector<std::uint8_t>& held_components() override {
-    // The components the end conditions change in a probe field (no value they set is 10^30),
-    // so that whatever the conditions do - faces, mirror ghosts, node sets, walls - is read
-    // from the conditions themselves.
-    held_.clear();
-    if (sim_.conditions_.empty() && sim_.velocity_conditions_.empty()) return held_;
-    constexpr double probe = 1.0e30;
-    std::vector<Vec<D>> field(sim_.nodes_.velocity_new.size(), Vec<D>::Constant(probe));
-    sim_.impose_conditions(field, VelocityConditions<D>::When::end);
-    held_.assign(static_cast<std::size_t>(sim_.grid_.n_nodes()), 0);
-    for_each_node(sim_.grid_.n_nodes(), [&](std::int32_t i) {
-      for (int a = 0; a < D; ++a)
-        if (field[i][a] != probe) held_[i] |= static_cast<std::uint8_t>(1U << a);
-    });
+    held_ = cairn::held_components(sim_.conditions_, sim_.velocity_conditions_, sim_.grid_.n_nodes());
     return held_;
   }
   void update_materials(const std::vector<Eigen::Matrix<double, D, D>>& velocity_gradient, double dt) override {
