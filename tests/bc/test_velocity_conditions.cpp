@@ -130,6 +130,20 @@ TEST(VelocityConditions, HeldComponentsAreReadFromTheConditions) {
   EXPECT_EQ(at(1.0, 0.25), 0b11);   // the oblique node set
   EXPECT_EQ(at(-1.0, 0.25), 0b01);  // the node set along x
   EXPECT_EQ(at(-1.0, -0.5), 0b11);  // the floor and the node set along x
+  // Every node agrees with what imposing the conditions on a probe field changes (a probe whose
+  // components differ, so that no projection on a direction vanishes).
+  const Vec<2> probe(1234.5, 2345.6);
+  std::vector<Vec<2>> field(grid.n_nodes(), probe);
+  sim.grid_conditions().apply(field, {}, nullptr, 1.0);
+  sim.velocity_conditions().apply(field, VelocityConditions<2>::When::end);
+  int n_held = 0;
+  for (std::int32_t i = 0; i < grid.n_nodes(); ++i) {
+    int changed = 0;
+    for (int a = 0; a < 2; ++a) changed |= (field[i][a] != probe[a]) << a;
+    EXPECT_EQ(held[i], changed) << "node " << i << " at " << grid.node_position(i).transpose();
+    n_held += changed != 0;
+  }
+  EXPECT_GT(n_held, 20);
   // Without any condition there is nothing to read.
   Simulation<2> free(load_config_string(bar(""), "b.toml"));
   EXPECT_TRUE(held_components(free.grid_conditions(), free.velocity_conditions(), free.grid().n_nodes()).empty());

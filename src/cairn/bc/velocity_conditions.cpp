@@ -166,16 +166,21 @@ std::vector<std::uint8_t> held_components(const GridConditions<D>& faces, const 
                                           std::int32_t n_nodes) {
   std::vector<std::uint8_t> held;
   if (faces.empty() && sets.empty()) return held;
-  // No value a condition sets is 10^30, and setting a component along a unit direction changes
-  // it (the probe minus its projection plus the value).
-  constexpr double probe = 1.0e30;
-  std::vector<Vec<D>> field(static_cast<std::size_t>(n_nodes), Vec<D>::Constant(probe));
-  faces.apply(field, {}, nullptr, 1.0);
-  sets.apply(field, VelocityConditions<D>::When::end);
   held.assign(static_cast<std::size_t>(n_nodes), 0);
-  for (std::int32_t i = 0; i < n_nodes; ++i)
+  // In the order apply() imposes them: the faces' held components; then every mirror ghost takes
+  // its source's value (all read before any is written) with the crossed faces' normals negated,
+  // so it is set where the source is held and along those normals, whatever was held there
+  // before; then each entry sets every component its direction has.
+  const auto& nodes = faces.nodes();
+  for (std::size_t k = 0; k < nodes.size(); ++k) held[nodes[k]] |= faces.masks()[k];
+  const auto& mirrors = faces.mirrors();
+  std::vector<std::uint8_t> mirrored(mirrors.size());
+  for (std::size_t k = 0; k < mirrors.size(); ++k)
+    mirrored[k] = static_cast<std::uint8_t>(mirrors[k].negate | held[mirrors[k].source]);
+  for (std::size_t k = 0; k < mirrors.size(); ++k) held[mirrors[k].node] = mirrored[k];
+  for (const auto& e : sets.entries())
     for (int a = 0; a < D; ++a)
-      if (field[i][a] != probe) held[i] |= static_cast<std::uint8_t>(1U << a);
+      if (e.direction[a] != 0.0) held[e.node] |= static_cast<std::uint8_t>(1U << a);
   return held;
 }
 

@@ -111,11 +111,10 @@ class VelocityConditions {
   std::vector<std::string> notes_;
 };
 
-/// Per node of a grid of `n_nodes` nodes, bit a set where the end values of `faces` and then
-/// `sets` set component a of a velocity field. Read from the conditions themselves by imposing
-/// them on a probe field, so faces, mirror ghosts, node sets and walls are all covered; a
-/// direction off the axes sets every component it has. Empty when there is no condition. Needs
-/// `sets` prepared for the step (VelocityConditions::prepare).
+/// Per node of a grid of `n_nodes` nodes, bit a set where imposing `faces` and then `sets`
+/// (apply) sets component a of a velocity field: held face components, mirror ghosts, node sets
+/// and walls; a direction off the axes sets every component it has. Empty when there is no
+/// condition. Needs `sets` prepared for the step (VelocityConditions::prepare).
 template <int D>
 std::vector<std::uint8_t> held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets,
                                           std::int32_t n_nodes);
