@@ -162,34 +162,30 @@ void VelocityConditions<D>::take_state(VelocityConditions&& old) {
 }
 
 template <int D>
-std::vector<std::uint8_t> held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets,
-                                          std::int32_t n_nodes) {
-  std::vector<std::uint8_t> held;
-  if (faces.empty() && sets.empty()) return held;
-  held.assign(static_cast<std::size_t>(n_nodes), 0);
+void held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets, std::int32_t n_nodes,
+                     std::vector<std::uint8_t>& held) {
+  held.clear();
+  if (faces.empty() && sets.empty()) return;
+  held.resize(static_cast<std::size_t>(n_nodes), 0);
   // In the order apply() imposes them: the faces' held components; then every mirror ghost takes
-  // its source's value (all read before any is written) with the crossed faces' normals negated,
-  // so it is set where the source is held and along those normals, whatever was held there
-  // before; then each entry sets every component its direction has.
+  // its source's value with the crossed faces' normals negated, so it is set where the source is
+  // held and along those normals, whatever was held there before (a source is never a ghost, so
+  // the order of the mirrors does not matter); then each entry sets every component its
+  // direction has.
   const auto& nodes = faces.nodes();
   for (std::size_t k = 0; k < nodes.size(); ++k) held[nodes[k]] |= faces.masks()[k];
-  const auto& mirrors = faces.mirrors();
-  std::vector<std::uint8_t> mirrored(mirrors.size());
-  for (std::size_t k = 0; k < mirrors.size(); ++k)
-    mirrored[k] = static_cast<std::uint8_t>(mirrors[k].negate | held[mirrors[k].source]);
-  for (std::size_t k = 0; k < mirrors.size(); ++k) held[mirrors[k].node] = mirrored[k];
+  for (const auto& m : faces.mirrors()) held[m.node] = static_cast<std::uint8_t>(m.negate | held[m.source]);
   for (const auto& e : sets.entries())
     for (int a = 0; a < D; ++a)
       if (e.direction[a] != 0.0) held[e.node] |= static_cast<std::uint8_t>(1U << a);
-  return held;
 }
 
-template std::vector<std::uint8_t> held_components(const GridConditions<1>&, const VelocityConditions<1>&,
-                                                   std::int32_t);
-template std::vector<std::uint8_t> held_components(const GridConditions<2>&, const VelocityConditions<2>&,
-                                                   std::int32_t);
-template std::vector<std::uint8_t> held_components(const GridConditions<3>&, const VelocityConditions<3>&,
-                                                   std::int32_t);
+template void held_components(const GridConditions<1>&, const VelocityConditions<1>&, std::int32_t,
+                              std::vector<std::uint8_t>&);
+template void held_components(const GridConditions<2>&, const VelocityConditions<2>&, std::int32_t,
+                              std::vector<std::uint8_t>&);
+template void held_components(const GridConditions<3>&, const VelocityConditions<3>&, std::int32_t,
+                              std::vector<std::uint8_t>&);
 
 template class VelocityConditions<1>;
 template class VelocityConditions<2>;

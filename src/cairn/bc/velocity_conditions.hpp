@@ -111,12 +111,13 @@ class VelocityConditions {
   std::vector<std::string> notes_;
 };
 
-/// Per node of a grid of `n_nodes` nodes, bit a set where imposing `faces` and then `sets`
-/// (apply) sets component a of a velocity field: held face components, mirror ghosts, node sets
-/// and walls; a direction off the axes sets every component it has. Empty when there is no
-/// condition. Needs `sets` prepared for the step (VelocityConditions::prepare).
+/// Into `held`, per node of a grid of `n_nodes` nodes, bit a set where imposing `faces` and then
+/// `sets` (apply) sets component a of a velocity field: held face components, mirror ghosts,
+/// node sets and walls; a direction off the axes sets every component it has. Left empty when
+/// there is no condition; its storage is kept from step to step. Needs `sets` prepared for the
+/// step (VelocityConditions::prepare).
 template <int D>
-std::vector<std::uint8_t> held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets,
-                                          std::int32_t n_nodes);
+void held_components(const GridConditions<D>& faces, const VelocityConditions<D>& sets, std::int32_t n_nodes,
+                     std::vector<std::uint8_t>& held);
 
 }  // namespace cairn

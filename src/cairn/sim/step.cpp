@@ -156,9 +156,8 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
   void impose_end_conditions() override {
     sim_.impose_conditions(sim_.nodes_.velocity_new, VelocityConditions<D>::When::end);
   }
-  const std::vector<std::uint8_t>& held_components() override {
-    held_ = cairn::held_components(sim_.conditions_, sim_.velocity_conditions_, sim_.grid_.n_nodes());
-    return held_;
+  void held_components(std::vector<std::uint8_t>& held) override {
+    cairn::held_components(sim_.conditions_, sim_.velocity_conditions_, sim_.grid_.n_nodes(), held);
   }
   void update_materials(const std::vector<Eigen::Matrix<double, D, D>>& velocity_gradient, double dt) override {
     const auto n = static_cast<std::int64_t>(sim_.particles_.n());
@@ -188,7 +187,6 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
  private:
   Simulation& sim_;
   detail::StageClock::time_point clock_;
-  std::vector<std::uint8_t> held_;
 };
 
 template <int D>

@@ -159,6 +159,10 @@ class Integrator {
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
                       const std::vector<std::uint8_t>* held = nullptr);
 
+  /// Storage for the components the velocity conditions set per node (bit a: component a), which
+  /// the engine fills each step for move_particles (wls/step.cpp).
+  [[nodiscard]] std::vector<std::uint8_t>& held_components() { return held_; }
+
   /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
   /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.
   void filter_acceleration(const Grid<D>& grid, NodeField<D>& nodes);
@@ -240,6 +244,7 @@ class Integrator {
   std::vector<Eigen::Matrix<double, D, D>> stress_;
   std::vector<Eigen::Matrix<double, D, D>> node_stress_power_;  ///< N_k of adjoint_point_stress
   std::vector<double> node_volume_;                           ///< W_k of adjoint_point_stress
+  std::vector<std::uint8_t> held_;  ///< held_components()
   std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
   std::vector<double> coef_;           ///< n_nodes x n_fields x n_basis: M^-1 l (Eq. 10), r in cells
   std::vector<std::uint8_t> alpha_;

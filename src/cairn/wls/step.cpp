@@ -24,7 +24,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
   }
   engine.lap(2);
   // Eq. 27-29 (or the quadrature gradient)
-  wls.move_particles(grid, nodes, particles, dt, &engine.held_components());
+  engine.held_components(wls.held_components());
+  wls.move_particles(grid, nodes, particles, dt, &wls.held_components());
   engine.lap(4);
   engine.update_materials(wls.particle_velocity_gradient(), dt);  // Eq. 30
   engine.lap(5);

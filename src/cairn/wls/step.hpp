@@ -31,9 +31,9 @@ class EngineStages {
   virtual void update_grid(double dt) = 0;
   /// The end-of-step velocity conditions on v+ again (after the filter changed it).
   virtual void impose_end_conditions() = 0;
-  /// Per node, bit a set where this step's velocity conditions set component a of v+ (a
-  /// condition along a direction off the axes sets every component it has).
-  virtual const std::vector<std::uint8_t>& held_components() = 0;
+  /// Into `held`, per node, bit a set where this step's velocity conditions set component a of
+  /// v+ (a condition along a direction off the axes sets every component it has); empty: none.
+  virtual void held_components(std::vector<std::uint8_t>& held) = 0;
   /// Eq. 30: F <- (I + L_p dt) F and the material stress of every particle from its velocity
   /// gradient L_p; a failing particle stops the step (SimulationFailure).
   virtual void update_materials(const std::vector<Eigen::Matrix<double, D, D>>& velocity_gradient, double dt) = 0;
