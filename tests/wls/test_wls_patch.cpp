@@ -586,5 +586,34 @@ TEST(WlsPatch, FreeDiskKeepsItsEnergyAtSmallSteps) {
   EXPECT_GT(node, 0.20);
 }
 
+TEST(WlsEnergyBudget, ParticlesKineticEnergyIsGridWorkPlusTransfer) {
+  // The budget of Integrator::grid_work / transfer_energy (docs/wls.md, "Energy budget"): after
+  // every step the particles' kinetic energy has changed by their sum, and the energy error
+  // splits into the transfer and what the forces did beyond the strain energy. A disk dropped on a
+  // symmetry floor (held node components, a mirror plane) with a body force, 300 steps.
+  Config c = patch_config("disk", 0.05);
+  c.bodies[0].shape.radius = 0.2;
+  c.bodies[0].shape.center = {0.5, 0.26};
+  c.bodies[0].velocity = {"0.1", "-0.2"};
+  c.materials[0].numbers = {{"density", 1000.0}, {"youngs_modulus", 5000.0}, {"poissons_ratio", 0.3}};
+  c.boundary.face[2] = FaceCondition::symmetry;
+  c.body_force.expression = {"0", "-2"};
+  c.method.time_integration = "central_difference";
+  Simulation<2> sim(c);
+  const wls::Integrator<2>& w = *sim.wls();
+  const auto t0 = sim.totals();
+  double biggest = 0.0;
+  for (int step = 0; step < 300; ++step) {
+    sim.step(sim.next_dt());
+    const auto t = sim.totals();
+    const double change = t.kinetic_energy - t0.kinetic_energy;
+    biggest = std::max(biggest, std::abs(w.grid_work()));
+    EXPECT_NEAR(change, w.grid_work() + w.transfer_energy(), 1e-12 * t0.kinetic_energy) << "step " << step;
+  }
+  // The floor took part: the grid did work of the order of the kinetic energy.
+  EXPECT_GT(biggest, 0.05 * t0.kinetic_energy);
+  EXPECT_NE(w.transfer_energy(), 0.0);
+}
+
 }  // namespace
 }  // namespace cairn

@@ -94,6 +94,10 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
     columns.push_back("displacement_error");
     columns.push_back("displacement_error_max");
   }
+  if (sim.wls()) {  // the WLS step's kinetic-energy budget (docs/wls.md, "Energy budget")
+    columns.push_back("wls_grid_work");
+    columns.push_back("wls_transfer_energy");
+  }
   if (const auto* c = sim.contact()) {
     columns.push_back("contact_nodes");
     columns.push_back("contact_active");
@@ -233,6 +237,13 @@ class MpmEngine final : public Engine {
     auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
+    if (auto* w = sim_.wls()) {  // absent from checkpoints written before the budget (counted as 0)
+      const auto scalar = [&](const char* key) {
+        const auto it = data.scalars.find(key);
+        return it == data.scalars.end() ? 0.0 : it->second;
+      };
+      w->restore_energy_budget(scalar("wls_grid_work"), scalar("wls_transfer_energy"));
+    }
     initial_energy_ = data.scalars.at("initial_energy");
     if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
     schedule_.restore(data.scalars, data.time);
@@ -406,6 +417,10 @@ class MpmEngine final : public Engine {
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
+    if (const auto* w = sim_.wls()) {
+      data.scalars["wls_grid_work"] = w->grid_work();
+      data.scalars["wls_transfer_energy"] = w->transfer_energy();
+    }
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
     data.snapshot_entries = snapshots_.entries();
@@ -487,6 +502,10 @@ class MpmEngine final : public Engine {
       row.push_back(error_now_);
       row.push_back(error_max_);
     }
+    if (const auto* w = sim_.wls()) {
+      row.push_back(w->grid_work());
+      row.push_back(w->transfer_energy());
+    }
     if (const auto* c = sim_.contact()) {
       row.push_back(static_cast<double>(c->contact_nodes()));
       row.push_back(static_cast<double>(c->active_nodes()));
@@ -507,7 +526,8 @@ class MpmEngine final : public Engine {
 
   /// The checkpoint's history rows in this run's columns: the same columns unless the run that
   /// wrote it had another number of ranks (the column `imbalance` exists on several ranks only;
-  /// rows restored onto several ranks from a one-rank checkpoint say 1 there).
+  /// rows restored onto several ranks from a one-rank checkpoint say 1 there) or it was written
+  /// before the WLS energy budget (its columns say 0 there, as its sums restart from 0).
   std::vector<std::vector<double>> rows_for_columns(const CheckpointData<D>& data) const {
     const auto& now = history_writer_.columns();
     if (data.history_columns == now) return data.history_rows;
@@ -520,6 +540,8 @@ class MpmEngine final : public Engine {
           row.push_back(stored[static_cast<std::size_t>(at - data.history_columns.begin())]);
         else if (name == "imbalance")
           row.push_back(1.0);
+        else if (name == "wls_grid_work" || name == "wls_transfer_energy")
+          row.push_back(0.0);
       }
       rows.push_back(std::move(row));  // a row still short of a column is refused by set_rows
     }

@@ -131,6 +131,7 @@ class Simulation {
   [[nodiscard]] const NodeField<D>& nodes() const { return nodes_; }
   /// The WLS method's state (method.integration = "wls", docs/wls.md), or null.
   [[nodiscard]] const wls::Integrator<D>* wls() const { return wls_.get(); }
+  [[nodiscard]] wls::Integrator<D>* wls() { return wls_.get(); }
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
   [[nodiscard]] Contact<D>* contact() { return contact_.get(); }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "cairn/parallel/exact_sum.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
 #include "cairn/wls/grid_stencil.hpp"
@@ -688,7 +689,19 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
-  gather(cache_, [&](std::int64_t p, const auto&) {
+  // The grid's kinetic-energy change (grid_work()), summed exactly (any thread count).
+  const std::int32_t n_nodes = grid.n_nodes();
+  ExactSum grid_change;
+#pragma omp parallel
+  {
+    ExactSum part;
+#pragma omp for schedule(static)
+    for (std::int32_t i = 0; i < n_nodes; ++i)
+      if (mass[i] > 0.0) part.add(0.5 * mass[i] * (v_new[i].squaredNorm() - v[i].squaredNorm()));
+#pragma omp critical(cairn_wls_budget)
+    grid_change += part;
+  }
+  const ExactSum particle_change = gather_sum(cache_, [&](std::int64_t p, const auto&) {
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
     const std::int32_t* axis_node = &cache_.axis_node[q];
     const double* axis_S = &cache_.axis_value[2 * q];
@@ -763,10 +776,14 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     }
     if (from_quadrature && weight > 0.0) L /= weight;
     // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11).
+    const double before = particles.velocity[p].squaredNorm();
     particles.velocity[p] = pic ? vx : Vec<D>(particles.velocity[p] + dv);
     particles.position[p] += vx * dt;
     particle_gradient_[p] = L;
+    return 0.5 * particles.mass[p] * (particles.velocity[p].squaredNorm() - before);
   });
+  grid_work_ += grid_change.value();
+  transfer_energy_ += particle_change.value() - grid_change.value();
 }
 
 template <int D>

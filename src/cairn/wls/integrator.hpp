@@ -159,6 +159,20 @@ class Integrator {
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
                       const std::vector<std::uint8_t>* held = nullptr);
 
+  /// Kinetic-energy budget of the steps so far (docs/wls.md, "Energy budget"), summed over the
+  /// move_particles calls: grid_work = the grid's kinetic energy change from v to v+ (the work of
+  /// the node forces; held components do no work), transfer_energy = the particles' kinetic
+  /// energy change (Eq. 27-28) beyond it. The particles' kinetic energy has changed by their sum,
+  /// so energy_error - transfer_energy is the work of the forces that neither the particles'
+  /// strain energy nor the external work accounts for.
+  [[nodiscard]] double grid_work() const { return grid_work_; }
+  [[nodiscard]] double transfer_energy() const { return transfer_energy_; }
+  /// Both sums from a checkpoint.
+  void restore_energy_budget(double grid_work, double transfer_energy) {
+    grid_work_ = grid_work;
+    transfer_energy_ = transfer_energy;
+  }
+
   /// Storage for the components the velocity conditions set per node (bit a: component a), which
   /// the engine fills each step for move_particles (wls/step.cpp).
   [[nodiscard]] std::vector<std::uint8_t>& held_components() { return held_; }
@@ -257,6 +271,8 @@ class Integrator {
   std::vector<std::int32_t> load_stamp_;  ///< scratch of spread_surface_loads
   std::vector<std::int32_t> load_nodes_;
   long long n_spurious_ = 0;
+  double grid_work_ = 0.0;        ///< grid_work()
+  double transfer_energy_ = 0.0;  ///< transfer_energy()
   // cells
   std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_
   std::vector<Region<D>> regions_;
