@@ -108,6 +108,12 @@ TEST(RunLoop, WlsRestartFromMidwayCheckpointIsBitIdentical) {
   expect_bit_identical_restart("wls", {"method.integration=\"wls\""});
 }
 
+TEST(RunLoop, WlsEnergyBudgetRestartsBitIdentical) {
+  // method.energy_budget (docs/wls.md, "Energy budget"): the checkpoint keeps both sums, so the
+  // history's wls_grid_work and wls_transfer_energy continue where they were.
+  expect_bit_identical_restart("wls_budget", {"method.integration=\"wls\"", "method.energy_budget=true"});
+}
+
 TEST(RunLoop, ContactReleasedBySeparationRestartsBitIdentical) {
   // [contact] release = "separation" keeps a pair in contact by the last step's record: the
   // checkpoint stores the record (/contact/in_contact). Without it this restart, from the middle

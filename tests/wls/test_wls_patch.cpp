@@ -599,6 +599,7 @@ TEST(WlsEnergyBudget, ParticlesKineticEnergyIsGridWorkPlusTransfer) {
   c.boundary.face[2] = FaceCondition::symmetry;
   c.body_force.expression = {"0", "-2"};
   c.method.time_integration = "central_difference";
+  c.method.plugin.set("energy_budget", true);
   Simulation<2> sim(c);
   const wls::Integrator<2>& w = *sim.wls();
   const auto t0 = sim.totals();

@@ -78,6 +78,12 @@ const std::vector<std::string> history_columns = {
     "dissipated_energy", "momentum_x", "momentum_y", "momentum_z", "mean_temperature",
     "max_pressure"};
 
+/// The run sums the WLS energy budget (method.energy_budget; docs/wls.md, "Energy budget").
+template <int D>
+bool has_energy_budget(const Simulation<D>& sim) {
+  return sim.wls() != nullptr && sim.wls()->options().energy_budget;
+}
+
 /// The columns of history.csv: the fixed ones, then per [[velocity]]/[[wall]] its reaction force
 /// reaction_<name>_<axis> (seed 000 Sec. 2.4, summed over its nodes, from the last step), then per
 /// wall its position wall_<name>_position; in multimaterial mode contact_nodes (nodes seeing two or
@@ -94,7 +100,7 @@ std::vector<std::string> history_columns_of(const Simulation<D>& sim) {
     columns.push_back("displacement_error");
     columns.push_back("displacement_error_max");
   }
-  if (sim.wls()) {  // the WLS step's kinetic-energy budget (docs/wls.md, "Energy budget")
+  if (has_energy_budget(sim)) {  // the WLS step's kinetic-energy budget (docs/wls.md, "Energy budget")
     columns.push_back("wls_grid_work");
     columns.push_back("wls_transfer_energy");
   }
@@ -237,7 +243,7 @@ class MpmEngine final : public Engine {
     auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
-    if (auto* w = sim_.wls()) {  // absent from checkpoints written before the budget (counted as 0)
+    if (auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {  // absent from checkpoints of runs without it: 0
       const auto scalar = [&](const char* key) {
         const auto it = data.scalars.find(key);
         return it == data.scalars.end() ? 0.0 : it->second;
@@ -417,7 +423,7 @@ class MpmEngine final : public Engine {
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
-    if (const auto* w = sim_.wls()) {
+    if (const auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {
       data.scalars["wls_grid_work"] = w->grid_work();
       data.scalars["wls_transfer_energy"] = w->transfer_energy();
     }
@@ -502,7 +508,7 @@ class MpmEngine final : public Engine {
       row.push_back(error_now_);
       row.push_back(error_max_);
     }
-    if (const auto* w = sim_.wls()) {
+    if (const auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {
       row.push_back(w->grid_work());
       row.push_back(w->transfer_energy());
     }
@@ -526,8 +532,9 @@ class MpmEngine final : public Engine {
 
   /// The checkpoint's history rows in this run's columns: the same columns unless the run that
   /// wrote it had another number of ranks (the column `imbalance` exists on several ranks only;
-  /// rows restored onto several ranks from a one-rank checkpoint say 1 there) or it was written
-  /// before the WLS energy budget (its columns say 0 there, as its sums restart from 0).
+  /// rows restored onto several ranks from a one-rank checkpoint say 1 there) or without the WLS
+  /// energy budget (method.energy_budget set on restart: its columns say 0 there, as its sums
+  /// start from 0).
   std::vector<std::vector<double>> rows_for_columns(const CheckpointData<D>& data) const {
     const auto& now = history_writer_.columns();
     if (data.history_columns == now) return data.history_rows;

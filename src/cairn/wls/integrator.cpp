@@ -689,19 +689,8 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
-  // The grid's kinetic-energy change (grid_work()), summed exactly (any thread count).
-  const std::int32_t n_nodes = grid.n_nodes();
-  ExactSum grid_change;
-#pragma omp parallel
-  {
-    ExactSum part;
-#pragma omp for schedule(static)
-    for (std::int32_t i = 0; i < n_nodes; ++i)
-      if (mass[i] > 0.0) part.add(0.5 * mass[i] * (v_new[i].squaredNorm() - v[i].squaredNorm()));
-#pragma omp critical(cairn_wls_budget)
-    grid_change += part;
-  }
-  const ExactSum particle_change = gather_sum(cache_, [&](std::int64_t p, const auto&) {
+  // Eq. 27-29 for particle p; returns its kinetic energy change (the energy budget's sum).
+  const auto move = [&](std::int64_t p, const auto&) {
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
     const std::int32_t* axis_node = &cache_.axis_node[q];
     const double* axis_S = &cache_.axis_value[2 * q];
@@ -781,7 +770,25 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     particles.position[p] += vx * dt;
     particle_gradient_[p] = L;
     return 0.5 * particles.mass[p] * (particles.velocity[p].squaredNorm() - before);
-  });
+  };
+  if (!options_.energy_budget) {
+    gather(cache_, move);
+    return;
+  }
+  // The grid's kinetic-energy change (grid_work()) and the particles', summed exactly (the same
+  // for any thread count).
+  const std::int32_t n_nodes = grid.n_nodes();
+  ExactSum grid_change;
+#pragma omp parallel
+  {
+    ExactSum part;
+#pragma omp for schedule(static)
+    for (std::int32_t i = 0; i < n_nodes; ++i)
+      if (mass[i] > 0.0) part.add(0.5 * mass[i] * (v_new[i].squaredNorm() - v[i].squaredNorm()));
+#pragma omp critical(cairn_wls_budget)
+    grid_change += part;
+  }
+  const ExactSum particle_change = gather_sum(cache_, move);
   grid_work_ += grid_change.value();
   transfer_energy_ += particle_change.value() - grid_change.value();
 }

@@ -89,6 +89,9 @@ struct Options {
   /// corners with mass (the partition of unity kept; docs/wls.md, departure 12); true = their
   /// zero velocity and acceleration enter the sums (as printed).
   bool massless_corners_included = false;
+  /// method.energy_budget: move_particles sums grid_work() and transfer_energy() (docs/wls.md,
+  /// "Energy budget"); off, both stay zero and the step does not pay for the sums.
+  bool energy_budget = false;
 };
 
 /// Loads on parts of the body's surface (tractions on particle faces, bc/traction.hpp), which
@@ -160,7 +163,7 @@ class Integrator {
                       const std::vector<std::uint8_t>* held = nullptr);
 
   /// Kinetic-energy budget of the steps so far (docs/wls.md, "Energy budget"), summed over the
-  /// move_particles calls: grid_work = the grid's kinetic energy change from v to v+ (the work of
+  /// move_particles calls with Options::energy_budget (zero without): grid_work = the grid's kinetic energy change from v to v+ (the work of
   /// the node forces; held components do no work), transfer_energy = the particles' kinetic
   /// energy change (Eq. 27-28) beyond it. The particles' kinetic energy has changed by their sum,
   /// so energy_error - transfer_energy is the work of the forces that neither the particles'

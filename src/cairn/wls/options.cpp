@@ -21,6 +21,7 @@ Options options(const MethodConfig& method) {
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
   o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
   o.every_symmetry_face_mirrors = method.plugin.text("mirror_planes") == "all";
+  o.energy_budget = method.plugin.boolean("energy_budget");
   return o;
 }
 
@@ -102,6 +103,13 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "27-28, so a rigid motion moves the particle rigidly (docs/wls.md); zero = its zero "
       "velocity and acceleration enter Eq. 27-28 (as printed).")
       .by_default("\"mean\"")
-      .choices([] { return std::vector<std::string>{"mean", "zero"}; })}});
+      .choices([] { return std::vector<std::string>{"mean", "zero"}; }),
+    Key("", "energy_budget", KeyType::boolean,
+      "WLS: add the history columns wls_grid_work (the work of the node forces on the "
+      "grid) and wls_transfer_energy (the particles' kinetic energy change in the particle "
+      "update beyond the grid's), which split energy_error into the forces' and the "
+      "velocity transfer's parts (docs/wls.md, \"Energy budget\"); two exact sums per "
+      "step, about 2 % of the step.")
+      .by_default("false")}});
 
 }  // namespace cairn::wls
