@@ -141,4 +141,25 @@ inline void sum_across(const Comm& comm, ExactSum* sums, int n) {
   }
 }
 
+/// Exact sums of N terms over p in [0, n): term(p, out) sets out[0..N), every thread adds into
+/// its own accumulators, merged exactly, so the result does not depend on the thread count or,
+/// summed across ranks (sum_across), on the partition.
+template <int N, class Fn>
+std::array<ExactSum, N> exact_sums(std::int64_t n, Fn&& term) {
+  std::array<ExactSum, N> total;
+#pragma omp parallel
+  {
+    std::array<ExactSum, N> local;
+    std::array<double, N> values{};
+#pragma omp for schedule(static)
+    for (std::int64_t p = 0; p < n; ++p) {
+      term(p, values);
+      for (int k = 0; k < N; ++k) local[k].add(values[k]);
+    }
+#pragma omp critical(cairn_exact_sums)
+    for (int k = 0; k < N; ++k) total[k] += local[k];
+  }
+  return total;
+}
+
 }  // namespace cairn

@@ -489,7 +489,7 @@ double Simulation<D>::material_dissipated_energy() const {
   // Exact sums over the owned particles and the ranks, like totals().
   const auto& P = particles_;
   const auto n = static_cast<std::int64_t>(n_owned());
-  std::array<ExactSum, 1> sum = detail::exact_sums<1>(n, [&](std::int64_t p, std::array<double, 1>& v) {
+  std::array<ExactSum, 1> sum = exact_sums<1>(n, [&](std::int64_t p, std::array<double, 1>& v) {
     const double* state = P.n_state_per_particle ? &P.state[p * static_cast<std::size_t>(P.n_state_per_particle)] : nullptr;
     v[0] = P.volume0[p] * materials_[P.material[p]]->dissipated_energy_density(state);
   });
@@ -663,7 +663,7 @@ Totals Simulation<D>::totals() const {
   // Exact sums over the owned particles and the ranks: the same totals for any partition.
   const auto& P = particles_;
   const auto n = static_cast<std::int64_t>(n_owned());
-  std::array<ExactSum, 7> sums = detail::exact_sums<7>(n, [&](std::int64_t p, std::array<double, 7>& v) {
+  std::array<ExactSum, 7> sums = exact_sums<7>(n, [&](std::int64_t p, std::array<double, 7>& v) {
     v[0] = 0.5 * P.mass[p] * P.velocity[p].squaredNorm();
     const double* state = P.n_state_per_particle ? &P.state[p * static_cast<std::size_t>(P.n_state_per_particle)] : nullptr;
     v[1] = P.volume0[p] * materials_[P.material[p]]->internal_energy_density(P.deformation_gradient[p], state);

@@ -18,27 +18,6 @@ namespace cairn::detail {
 /// The clock of the per-stage wall times (Simulation::stage_times).
 using StageClock = std::chrono::steady_clock;
 
-/// Exact sums of N terms over p in [0, n): term(p, out) sets out[0..N), every thread adds into
-/// its own accumulators, merged exactly, so the result does not depend on the thread count or,
-/// summed across ranks, on the partition (parallel/exact_sum.hpp).
-template <int N, class Fn>
-std::array<ExactSum, N> exact_sums(std::int64_t n, Fn&& term) {
-  std::array<ExactSum, N> total;
-#pragma omp parallel
-  {
-    std::array<ExactSum, N> local;
-    std::array<double, N> values{};
-#pragma omp for schedule(static)
-    for (std::int64_t p = 0; p < n; ++p) {
-      term(p, values);
-      for (int k = 0; k < N; ++k) local[k].add(values[k]);
-    }
-#pragma omp critical(cairn_exact_sums)
-    for (int k = 0; k < N; ++k) total[k] += local[k];
-  }
-  return total;
-}
-
 /// Node position relative to the particle, taking the periodic wrap into account.
 template <int D>
 Vec<D> node_offset(const Grid<D>& grid, std::int32_t node, const Vec<D>& x) {

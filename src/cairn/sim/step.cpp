@@ -478,7 +478,7 @@ void Simulation<D>::update_grid(double dt) {
   if (node_work) {
     const std::int32_t nn = grid_.n_nodes();
     const bool whole = grid_.is_whole();
-    work[2] = detail::exact_sums<1>(n_slots(), [&](std::int64_t i, std::array<double, 1>& w) {
+    work[2] = exact_sums<1>(n_slots(), [&](std::int64_t i, std::array<double, 1>& w) {
       w[0] = 0.0;
       if (!whole && !grid_.owns(static_cast<std::int32_t>(i % nn))) return;
       const Vec<D> v_mean = 0.5 * (nodes_.velocity[i] + nodes_.velocity_new[i]);

@@ -218,6 +218,13 @@ class Integrator {
   static constexpr int n_fields = 2 * D + 1 + n_stress;
   /// Fields per row of the sums, padded to pairs (the scatter adds two fields at a time).
   static constexpr int n_row = n_fields + n_fields % 2;
+  /// Position of stress component (a, b) among the n_stress fitted ones: diagonal first, then
+  /// (in 3D) yz, xz, xy; in 2D xy.
+  static constexpr int voigt(int a, int b) {
+    if (a == b) return a;
+    if constexpr (D == 2) return 2;
+    return 3 + (3 - a - b);  // (1,2) -> 3, (0,2) -> 4, (0,1) -> 5
+  }
 
   void fit_nodes(const Grid<D>& grid, int n_used_fields);
   void extrapolate_spurious_velocity(const Grid<D>& grid);
