@@ -206,6 +206,21 @@ TEST(Decomposition, RebalanceWithinToleranceMovesNoParticle) {
   EXPECT_LE(cost_imbalance(moved, cells, weights), 1.06);
 }
 
+template <int D>
+void check_index_round_trip(const Grid<D>& g) {
+  for (std::int32_t i = 0; i < g.n_nodes(); ++i) ASSERT_EQ(g.node_index(g.multi_index(i)), i) << i;
+}
+
+TEST(GridIndex, MultiIndexInvertsNodeIndexIn1D2D3D) {
+  // Ghost layers (negative multi-indices), a periodic axis and unequal extents.
+  check_index_round_trip(Grid<1>(Vec<1>(0.0), IVec<1>(7), Vec<1>(0.5), 2, {false}));
+  check_index_round_trip(Grid<2>(Vec<2>(0.0, 0.0), IVec<2>(5, 9), Vec<2>(0.5, 0.25), 1, {true, false}));
+  check_index_round_trip(Grid<3>(Vec<3>(0.0, 0.0, 0.0), IVec<3>(4, 6, 3), Vec<3>(1.0, 1.0, 1.0), 2, {false, true, false}));
+  const Grid<3> g(Vec<3>(0.0, 0.0, 0.0), IVec<3>(4, 6, 3), Vec<3>(1.0, 1.0, 1.0), 0, {false, false, false});
+  EXPECT_EQ(g.multi_index(g.n_nodes() - 1), IVec<3>(4, 6, 3));
+  EXPECT_EQ(g.multi_index(5 + 5 * 7), IVec<3>(0, 1, 1));  // 5 nodes along x, 7 along y
+}
+
 TEST(GridWindow, TranslatesBetweenDomainAndStorage) {
   // 20 x 8 cells, x not periodic with 2 ghost layers, y periodic.
   Grid<2> whole(Vec<2>(0.0, 0.0), IVec<2>(20, 8), Vec<2>(0.5, 0.5), 2, {false, true});

@@ -119,9 +119,18 @@ class Grid {
   /// Multi-index (domain numbering, may be negative for ghost nodes; in [0, n_cells) on a
   /// periodic axis) of a stored node.
   [[nodiscard]] IVec<D> multi_index(std::int32_t idx) const {
+    // idx in [0, n_nodes()), axis 0 fastest: D - 1 divisions, each giving a quotient and its
+    // remainder (one instruction), where (idx / stride_a) % stored_a took two per axis (the
+    // WLS integrator's node loops call this for every node, several times a step).
     IVec<D> j;
+    std::int32_t rest = idx;
+    for (int a = 0; a + 1 < D; ++a) {
+      j[a] = rest % stored_[a];
+      rest /= stored_[a];
+    }
+    j[D - 1] = rest;
     for (int a = 0; a < D; ++a) {
-      j[a] = (idx / stride_[a]) % stored_[a] + first_[a];
+      j[a] += first_[a];
       if (periodic_[a] && j[a] >= n_cells_[a]) j[a] -= n_cells_[a];
       if (periodic_[a] && j[a] < 0) j[a] += n_cells_[a];
     }

@@ -217,6 +217,12 @@ const char* Simulation<D>::update_stress_at(std::int64_t p, const Eigen::Matrix<
   } else {
     update_stress_of(static_cast<std::size_t>(p), zero, identity, dt);
   }
+  return failed_quantity(static_cast<std::size_t>(p));
+}
+
+template <int D>
+const char* Simulation<D>::failed_quantity(std::size_t p) const {
+  const Mat3& F = particles_.deformation_gradient[p];
   const SymMat3& tau = particles_.kirchhoff_stress[p];
   // det F; below 3D F is block diagonal [[F_D, 0], [0, F_zz]].
   const double J = D == 3 ? F.determinant() : F(2, 2) * (F(0, 0) * F(1, 1) - F(0, 1) * F(1, 0));
@@ -235,14 +241,12 @@ const char* Simulation<D>::update_stress_at(std::int64_t p, const Eigen::Matrix<
 template <int D>
 const char* Simulation<D>::update_particle(std::size_t p, const Mat3& L, const Mat3& dF, double dt) {
   Mat3& F = particles_.deformation_gradient[p];
-  F = dF * F;
+  // Below 3D dF = [[dF_D, 0], [0, 1]]: only the first D rows of F change (the same values as
+  // the full product, which adds zeros).
+  if constexpr (D == 3) F = dF * F;
+  else F.template topRows<D>() = (dF.template topLeftCorner<D, D>() * F.template topRows<D>()).eval();
   update_stress_of(p, L, dF, dt);
-  const double J = F.determinant();
-  if (!particles_.velocity[p].allFinite()) return "velocity";
-  if (!particles_.position[p].allFinite()) return "position";
-  if (!(J > 0.0)) return "det F";
-  if (!particles_.kirchhoff_stress[p].allFinite()) return "stress";
-  return nullptr;
+  return failed_quantity(p);
 }
 
 template <int D>
@@ -272,6 +276,7 @@ void Simulation<D>::particle_failure(std::int64_t first_bad, const std::string& 
   template void Simulation<D>::update_stresses(const std::vector<Vec<D>>&, double); \
   template const char* Simulation<D>::update_stress_at(std::int64_t, const Eigen::Matrix<double, D, D>&, double, bool); \
   template const char* Simulation<D>::update_particle(std::size_t, const Mat3&, const Mat3&, double); \
+  template const char* Simulation<D>::failed_quantity(std::size_t) const; \
   template void Simulation<D>::particle_failure(std::int64_t, const std::string&) const; \
 
 CAIRN_INSTANTIATE(1)

@@ -268,6 +268,8 @@ class Simulation {
   /// Task 5 for particle p from its velocity gradient: F, the stress and the failure checks
   /// (returns what is not finite or not positive, or nullptr).
   const char* update_stress_at(std::int64_t p, const Eigen::Matrix<double, D, D>& L_D, double dt, bool increments);
+  /// What of particle p is not finite (velocity, position, stress) or det F <= 0, or nullptr.
+  [[nodiscard]] const char* failed_quantity(std::size_t p) const;
   [[nodiscard]] bool uses_increments() const;  ///< any material reads MaterialPoint::L or dF
   static void record_failure(std::int64_t p, const char* bad, std::int64_t& first_bad, std::string& what);
   [[nodiscard]] double max_signal_speed() const;

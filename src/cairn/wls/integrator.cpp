@@ -38,6 +38,40 @@ template <int D, class Fn>
   }
 }
 
+/// fn(k) for the 2^D entries of a WLS stencil where the narrow shape S (Eq. 5) and its gradient
+/// (Eq. 6) can be nonzero: the corners of the particle's cell, entries first..first + 1 along each
+/// axis, with first = 0 where S[0] != 0 (build_stencils: shift 1, x_p in the cell's upper half)
+/// and 1 otherwise. The other entries give S = G = 0 exactly, so the sums skip only zero terms.
+template <int D, class Fn>
+[[gnu::always_inline]] inline void for_each_corner_slot(const double* axis_S, Fn&& fn) {
+  int first[D];
+  for (int a = 0; a < D; ++a) first[a] = axis_S[6 * a] != 0.0 ? 0 : 1;
+  if constexpr (D == 1) {
+    for (int i = 0; i < 2; ++i) fn(std::array<int, 1>{first[0] + i});
+  } else if constexpr (D == 2) {
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) fn(std::array<int, 2>{first[0] + i, first[1] + j});
+  } else {
+    for (int l = 0; l < 2; ++l)
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) fn(std::array<int, 3>{first[0] + i, first[1] + j, first[2] + l});
+  }
+}
+
+/// Stencil entry k of a particle in the tensor layout of build_stencils: its node's storage index
+/// (the sum of the axes' offsets) and the product of its per-axis factors, `stride` apart per
+/// axis (3 for the wide W, 6 for the narrow S whose gradients follow each axis's values).
+template <int D, int stride>
+[[gnu::always_inline]] inline std::int32_t stencil_entry(const std::array<int, D>& k, const std::int32_t* axis_node,
+                                                         const double* axis_factor, double& product) {
+  std::int32_t i = 0;
+  product = 1.0;
+  for (int a = 0; a < D; ++a) {
+    i += axis_node[3 * a + k[a]];
+    product *= axis_factor[stride * a + k[a]];
+  }
+  return i;
+}
 
 /// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
 constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
@@ -53,8 +87,11 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   }
   const std::int32_t n = grid.n_nodes();
   sums_.assign(n, NodeSums{});
-  load_.assign(static_cast<std::size_t>(n) * n_basis * n_row, 0.0);
-  coef_.assign(static_cast<std::size_t>(n) * n_fields * n_basis, 0.0);
+  // The slopes of the fits are read only by the fitted point values and the extrapolated
+  // spurious velocity; otherwise the values c0 alone are formed (Eq. 11).
+  n_coef_ = options.fitted_point_values || options.extrapolated_spurious_velocity ? n_basis : 1;
+  coef_.assign(static_cast<std::size_t>(n) * n_coef_ * n_row, 0.0);
+  inverse_rows_.assign(static_cast<std::size_t>(n) * n_coef_ * n_basis, 0.0);
   count_.assign(n, 0);
   surface_sum_.assign(n, Vec<D>::Zero());
   surface_weight_.assign(n, 0.0);
@@ -62,7 +99,6 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   density_.assign(n, 0.0);
   force_density_.assign(n, Vec<D>::Zero());
   stress_.assign(n, Eigen::Matrix<double, D, D>::Zero());
-  inverse_.assign(n, Eigen::Matrix<double, n_basis, n_basis>::Zero());
   alpha_.assign(n, 0);
   live_.assign(n, 1);  // every node is fitted at the first step
   distance_.assign(n, 0.0);
@@ -146,7 +182,6 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
                             NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force, bool surface_loads) {
   const auto n = static_cast<std::int64_t>(particles.n());
   const bool body_force = body_acceleration != nullptr;
-  const int n_used = body_force ? n_fields : n_fields - D;
   // Sec. 4.1: J_p, rho_p = rho0 / J_p, sigma_p = tau_p / J_p, f_p = rho_p b_p; a row of n_row
   // values per particle (the fields, padded with zeros to pairs).
   particle_fields_.resize(static_cast<std::size_t>(n) * n_row);
@@ -168,82 +203,122 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     // W > 0, Eq. 4-5): nodes no particle counted last time are still zero (about half of them).
     if (count_[i] != 0) {
       sums_[i] = NodeSums{};
-      std::fill_n(&load_[static_cast<std::size_t>(i) * n_basis * n_row], n_basis * n_row, 0.0);
+      std::fill_n(&coef_[static_cast<std::size_t>(i) * n_coef_ * n_row], n_coef_ * n_row, 0.0);
     }
     count_[i] = 0;
     surface_sum_[i].setZero();
     surface_weight_[i] = 0.0;
   });
-  // Moment matrices and load vectors (Eq. 9) with the wide weight; particle flags (Eq. 13) and
-  // surface positions (Eq. 15) with the narrow shape. The loads are summed in pairs of fields
-  // (GCC/Clang vector extensions, SSE2: the same operations per field), over a compile-time
-  // number of pairs (with and without the body-force density).
+  // First pass: moment matrices (Eq. 9) with the wide weight; particle flags (Eq. 13) and
+  // surface positions (Eq. 15) with the narrow shape.
+  scatter(cache_, [&](std::int32_t p, const auto&) {
+    const std::size_t q = static_cast<std::size_t>(p) * D * 3;
+    const std::int32_t* axis_node = &cache_.axis_node[q];
+    const double* axis_S = &cache_.axis_value[2 * q];
+    const double* axis_W = &wide_[q];
+    const double* axis_r = &offset_[q];
+    const bool surface = is_surface(particles, static_cast<std::size_t>(p));
+    const double flag = surface ? 1.0 : 2.0;
+    const Vec<D>& x_p = particles.position[p];
+    // The flags and surface positions over the 2^D corners where S can be nonzero ...
+    for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) __attribute__((always_inline)) {
+      double S;
+      const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
+      sums_[i].beta += S * flag;
+      if (surface && S != 0.0) {
+        // Along a periodic axis the particle's image next to the node (x_i + r h), so that
+        // x_surf of a node on the seam averages the particles on both sides of it.
+        Vec<D> x = x_p;
+        if (any_periodic_) {
+          const Vec<D> xi = grid.node_position(i);
+          for (int a = 0; a < D; ++a)
+            if (periodic_[a]) x[a] = xi[a] + axis_r[3 * a + k[a]] * h_[a];
+        }
+        surface_sum_[i] += S * x;
+        surface_weight_[i] += S;
+      }
+    });
+    // ... and the moments over all 3^D entries. The basis [1, r] at r = x_p - x_i in cells
+    // (PlaneFit::basis) is a tensor product too: W b_r b_c = prod_a W_a r_a^(e_a) with e_a = 0, 1
+    // or 2, from per-axis factors formed once per particle.
+    double factor[D][3][3];  // [axis][entry][power of r]
+    for (int a = 0; a < D; ++a)
+      for (int k = 0; k < 3; ++k) {
+        const double w = axis_W[3 * a + k], r = axis_r[3 * a + k];
+        factor[a][k][0] = w;
+        factor[a][k][1] = w * r;
+        factor[a][k][2] = w * r * r;
+      }
+    for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
+      double W;
+      const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
+      if (W <= 0.0) return;
+      NodeSums& sum = sums_[i];
+      auto& M = sum.moment;
+      for (int r = 0; r < n_basis; ++r)
+        for (int c = r; c < n_basis; ++c) {
+          // Entry (r, c) of b b^T: power 1 of r_(r-1) and of r_(c-1) (2 where they coincide).
+          double m = 1.0;
+          for (int a = 0; a < D; ++a) m *= factor[a][k[a]][(r == 1 + a) + (c == 1 + a)];
+          M[packed(r, c, n_basis)] += m;
+        }
+      sum.max_weight = std::max(sum.max_weight, W);
+      ++count_[i];
+    });
+  });
+  fit_nodes(grid);
+  // Second pass: the coefficients c = M^-1 l of every field (Eq. 10) summed directly, c_ck +=
+  // psi_c f_k with psi_c = W (M^-1 b)_c: the loads l of Eq. 9 are never formed, so each stencil
+  // entry adds one value per field and coefficient (the node values c0 alone unless slopes are
+  // read) instead of n_basis. The fields are added in pairs (GCC/Clang vector extensions, SSE2:
+  // the same operations per field) over compile-time numbers of pairs and coefficients.
   using Pair = double __attribute__((vector_size(16), may_alias));
-  auto sums = [&]<int n_pair>() {
+  auto fits = [&]<int n_pair, int n_coef>() {
     scatter(cache_, [&](std::int32_t p, const auto&) {
       const std::size_t q = static_cast<std::size_t>(p) * D * 3;
       const std::int32_t* axis_node = &cache_.axis_node[q];
-      const double* axis_S = &cache_.axis_value[2 * q];
       const double* axis_W = &wide_[q];
       const double* axis_r = &offset_[q];
-      const bool surface = is_surface(particles, static_cast<std::size_t>(p));
-      const double flag = surface ? 1.0 : 2.0;
-      const Vec<D>& x_p = particles.position[p];
       const Pair* f = reinterpret_cast<const Pair*>(&particle_fields_[static_cast<std::size_t>(p) * n_row]);
       for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
-        std::int32_t i = 0;
-        double W = 1.0, S = 1.0;
-        for (int a = 0; a < D; ++a) {
-          i += axis_node[3 * a + k[a]];
-          W *= axis_W[3 * a + k[a]];
-          S *= axis_S[6 * a + k[a]];
-        }
-        // The basis [1, r] at r = x_p - x_i in cells (PlaneFit::basis), as scalars: kept in an
-        // array, the compiler stored its entries one by one and loaded them back in pairs (a
-        // store-forwarding stall that took a quarter of the scatter).
+        double W;
+        const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
+        if (W <= 0.0) return;
         const double r0 = axis_r[k[0]];
         const double r1 = D > 1 ? axis_r[3 + k[D > 1 ? 1 : 0]] : 0.0;
         const double r2 = D > 2 ? axis_r[6 + k[D > 2 ? 2 : 0]] : 0.0;
-        const auto b = [&](int r) { return r == 0 ? 1.0 : r == 1 ? r0 : r == 2 ? r1 : r2; };
-        NodeSums& sum = sums_[i];
-        sum.beta += S * flag;  // adds zero where S = 0
-        if (surface && S != 0.0) {
-          // Along a periodic axis the particle's image next to the node (x_i + r h), so that
-          // x_surf of a node on the seam averages the particles on both sides of it.
-          Vec<D> x = x_p;
-          if (any_periodic_) {
-            const Vec<D> xi = grid.node_position(i);
-            for (int a = 0; a < D; ++a)
-              if (periodic_[a]) x[a] = xi[a] + b(1 + a) * h_[a];
-          }
-          surface_sum_[i] += S * x;
-          surface_weight_[i] += S;
+        const double* inverse = &inverse_rows_[static_cast<std::size_t>(i) * n_coef * n_basis];
+        Pair psi[n_coef];
+        for (int c = 0; c < n_coef; ++c) {
+          const double* row = inverse + c * n_basis;
+          double v = row[0] + row[1] * r0;
+          if constexpr (D > 1) v += row[2] * r1;
+          if constexpr (D > 2) v += row[3] * r2;
+          psi[c] = Pair{W * v, W * v};
         }
-        if (W <= 0.0) return;
-        auto& M = sum.moment;
-        for (int r = 0; r < n_basis; ++r)
-          for (int c = r; c < n_basis; ++c) M[packed(r, c, n_basis)] += W * b(r) * b(c);
-        // Per basis function a row of the fields: l_rk += (W f_k) b_r, along the row in pairs.
-        Pair* l = reinterpret_cast<Pair*>(&load_[static_cast<std::size_t>(i) * n_basis * n_row]);
-        const Pair W2 = {W, W};
-        for (int m = 0; m < n_pair; ++m) {
-          const Pair wf = W2 * f[m];
-          for (int r = 0; r < n_basis; ++r) {
-            const Pair b2 = {b(r), b(r)};
-            l[r * (n_row / 2) + m] += wf * b2;
-          }
-        }
-        sum.max_weight = std::max(sum.max_weight, W);
-        ++count_[i];
+        Pair* l = reinterpret_cast<Pair*>(&coef_[static_cast<std::size_t>(i) * n_coef * n_row]);
+        for (int m = 0; m < n_pair; ++m)
+          for (int c = 0; c < n_coef; ++c) l[c * (n_row / 2) + m] += psi[c] * f[m];
       });
     });
   };
-  if (body_force) {
-    sums.template operator()<(n_fields + 1) / 2>();
+  constexpr int all_pairs = (n_fields + 1) / 2, no_body_pairs = (n_fields - D + 1) / 2;
+  if (n_coef_ == 1) {
+    if (body_force) fits.template operator()<all_pairs, 1>();
+    else fits.template operator()<no_body_pairs, 1>();
   } else {
-    sums.template operator()<(n_fields - D + 1) / 2>();
+    if (body_force) fits.template operator()<all_pairs, n_basis>();
+    else fits.template operator()<no_body_pairs, n_basis>();
   }
-  fit_nodes(grid, n_used);
+  for_each_node(n_nodes, [&](std::int32_t i) {  // the node values c0 (Eq. 11)
+    if (count_[i] == 0) return;
+    auto value = [&](int k) { return coefficient(i, k, 0); };
+    for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
+    density_[i] = value(D);
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b) stress_[i](a, b) = stress_[i](b, a) = value(D + 1 + voigt(a, b));
+    for (int a = 0; a < D; ++a) force_density_[i][a] = body_force ? value(D + 1 + n_stress + a) : 0.0;
+  });
   if (options_.extrapolated_spurious_velocity) extrapolate_spurious_velocity(grid);
   refine_distance(grid);
   build_regions(grid);
@@ -274,28 +349,18 @@ void Integrator<D>::adjoint_point_stress(const Grid<D>& grid, const Particles<D>
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
     const std::int32_t* axis_node = &cache_.axis_node[q];
     const double* axis_S = &cache_.axis_value[2 * q];
-    auto node_and_S = [&](const std::array<int, D>& k, std::int32_t& i, double& S) {
-      i = 0;
-      S = 1.0;
-      for (int a = 0; a < D; ++a) {
-        i += axis_node[3 * a + k[a]];
-        S *= axis_S[6 * a + k[a]];
-      }
-    };
     double s_p = 0.0;
-    for_each_slot<D>([&](const std::array<int, D>& k) {
-      std::int32_t i;
+    for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) {
       double S;
-      node_and_S(k, i, S);
+      const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
       if (node_volume_[i] > 0.0) s_p += S;
     });
     if (!(s_p > 0.0) || particles.volume0[p] == 0.0) return;
     const Eigen::Matrix<double, D, D> tau =
         particles.kirchhoff_stress[p].full().template topLeftCorner<D, D>() * (particles.volume0[p] / s_p);
-    for_each_slot<D>([&](const std::array<int, D>& k) {
-      std::int32_t i;
+    for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) {
       double S;
-      node_and_S(k, i, S);
+      const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
       if (node_volume_[i] > 0.0 && S != 0.0) node_stress_power_[i] += S * tau;
     });
   });
@@ -313,7 +378,7 @@ void Integrator<D>::adjoint_point_stress(const Grid<D>& grid, const Particles<D>
 }
 
 template <int D>
-void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
+void Integrator<D>::fit_nodes(const Grid<D>& grid) {
   const std::int32_t n_nodes = grid.n_nodes();
   const double h = grid.min_cell_size();
   std::vector<long long> spurious(static_cast<std::size_t>(omp_get_max_threads()), 0);
@@ -343,14 +408,7 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     density_[i] = 0.0;
     force_density_[i].setZero();
     stress_[i].setZero();
-    inverse_[i].setZero();
     alpha_[i] = 0;
-    // The slopes of the fits are read only by the fitted point values and the extrapolated
-    // spurious velocity (options); otherwise the values c0 alone are formed (Eq. 11).
-    const bool slopes = options_.fitted_point_values || options_.extrapolated_spurious_velocity;
-    const int n_coef = slopes ? n_basis : 1;
-    double* coef = &coef_[static_cast<std::size_t>(i) * n_fields * n_basis];
-    if (slopes) std::fill_n(coef, n_fields * n_basis, 0.0);
     if (count_[i] == 0) return;
     Eigen::Matrix<double, n_basis, n_basis> M;
     for (int r = 0; r < n_basis; ++r)
@@ -358,23 +416,12 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
     // Sec. 3.5: too few particles, or none above the trigger weight: constant fit only.
     const bool reduce = count_[i] < D + 1 || sums_[i].max_weight < options_.trigger_weight;
     bool reduced = true;
-    inverse_[i] = PlaneFit<D>::inverse(M, reduce, &reduced);
+    const Eigen::Matrix<double, n_basis, n_basis> inverse = PlaneFit<D>::inverse(M, reduce, &reduced);
+    double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];  // read by collect's fits
+    for (int c = 0; c < n_coef_; ++c)
+      for (int r = 0; r < n_basis; ++r) rows[c * n_basis + r] = inverse(c, r);
     alpha_[i] = reduced ? 0 : 1;
     if (reduced) ++spurious[static_cast<std::size_t>(omp_get_thread_num())];
-    const double* l = &load_[static_cast<std::size_t>(i) * n_basis * n_row];
-    for (int k = 0; k < n_used; ++k)  // c = M^-1 l of field k (Eq. 10); zero slopes where reduced
-      for (int c = 0; c < n_coef; ++c) {
-        double sum = 0.0;
-        for (int r = 0; r < n_basis; ++r) sum += inverse_[i](c, r) * l[r * n_row + k];
-        coef[k * n_basis + c] = sum;
-      }
-    auto value = [&](int k) { return coef[k * n_basis]; };  // c0 of field k (Eq. 11)
-    for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
-    density_[i] = value(D);
-    for (int a = 0; a < D; ++a)
-      for (int b = a; b < D; ++b) stress_[i](a, b) = stress_[i](b, a) = value(D + 1 + voigt(a, b));
-    if (n_used == n_fields)
-      for (int a = 0; a < D; ++a) force_density_[i][a] = value(D + 1 + n_stress + a);
   });
   n_spurious_ = 0;
   for (long long s : spurious) n_spurious_ += s;
@@ -383,13 +430,9 @@ void Integrator<D>::fit_nodes(const Grid<D>& grid, int n_used) {
 template <int D>
 Eigen::Matrix<double, D, D> Integrator<D>::velocity_gradient_fit(std::int32_t i) const {
   Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-  const double* l = &load_[static_cast<std::size_t>(i) * n_basis * n_row];
+  if (n_coef_ == 1) return L;  // slopes not fitted (see the declaration)
   for (int a = 0; a < D; ++a)
-    for (int b = 0; b < D; ++b) {
-      double c = 0.0;
-      for (int r = 0; r < n_basis; ++r) c += inverse_[i](1 + b, r) * l[r * n_row + a];
-      L(a, b) = c / h_[b];  // Eq. 12, back from cell units
-    }
+    for (int b = 0; b < D; ++b) L(a, b) = coefficient(i, a, 1 + b) / h_[b];  // Eq. 12, back from cell units
   return L;
 }
 
@@ -415,10 +458,9 @@ void Integrator<D>::extrapolate_spurious_velocity(const Grid<D>& grid) {
     int n = 0;
     for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& offset) {
       if (!alpha_[nb]) return;
-      const double* coef = &coef_[static_cast<std::size_t>(nb) * n_fields * n_basis];
       for (int a = 0; a < D; ++a) {  // velocity component a is field a; x_i - x_nb = -offset
-        sum[a] += coef[a * n_basis];
-        for (int b = 0; b < D; ++b) sum[a] -= coef[a * n_basis + 1 + b] * offset[b];
+        sum[a] += coefficient(nb, a, 0);
+        for (int b = 0; b < D; ++b) sum[a] -= coefficient(nb, a, 1 + b) * offset[b];
       }
       ++n;
     });
@@ -571,13 +613,9 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
     double weight = 0.0;
     bool massless = false;  // a node with S_ip > 0 and no mass
-    for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
-      std::int32_t i = 0;
-      double S = 1.0;
-      for (int a = 0; a < D; ++a) {
-        i += axis_node[3 * a + k[a]];
-        S *= axis_S[6 * a + k[a]];
-      }
+    for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) __attribute__((always_inline)) {
+      double S;
+      const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
       massless |= S != 0.0 && !(mass[i] > 0.0);
       dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
       vx += S * v_new[i];           // Eq. 28
@@ -607,13 +645,9 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       Vec<D> dv_h = Vec<D>::Zero(), vx_h = Vec<D>::Zero();  // over held components without mass
       Vec<D> S_h = Vec<D>::Zero();
       double S_m = 0.0, S_all = 0.0;
-      for_each_slot<D>([&](const std::array<int, D>& k) {
-        std::int32_t i = 0;
-        double S = 1.0;
-        for (int a = 0; a < D; ++a) {
-          i += axis_node[3 * a + k[a]];
-          S *= axis_S[6 * a + k[a]];
-        }
+      for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) {
+        double S;
+        const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
         S_all += S;
         if (mass[i] > 0.0) {
           S_m += S;

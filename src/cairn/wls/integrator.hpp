@@ -201,7 +201,9 @@ class Integrator {
   [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& node_stress() const { return stress_; }
   /// beta_i of Eq. 13 (with the mirror images across symmetry planes).
   [[nodiscard]] double node_flag(std::int32_t i) const { return sums_[i].beta; }
-  /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced.
+  /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced,
+  /// and zero unless the options read the fits' slopes (fitted_point_values or
+  /// extrapolated_spurious_velocity: otherwise only the node values are fitted).
   [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
   /// Moment matrix M of node i (Eq. 9, r in cells) from the last collect.
   [[nodiscard]] Eigen::Matrix<double, D + 1, D + 1> moment_matrix(std::int32_t i) const;
@@ -226,7 +228,11 @@ class Integrator {
     return 3 + (3 - a - b);  // (1,2) -> 3, (0,2) -> 4, (0,1) -> 5
   }
 
-  void fit_nodes(const Grid<D>& grid, int n_used_fields);
+  void fit_nodes(const Grid<D>& grid);
+  /// Coefficient c (0: the value, 1 + a: the slope along a, in cells) of field k's fit at node i.
+  [[nodiscard]] double coefficient(std::int32_t i, int k, int c) const {
+    return coef_[(static_cast<std::size_t>(i) * n_coef_ + c) * n_row + k];
+  }
   void extrapolate_spurious_velocity(const Grid<D>& grid);
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
@@ -249,7 +255,7 @@ class Integrator {
   std::vector<double> offset_;         ///< n x D x 3: x_p - x_i in cells per axis
   std::vector<double> particle_fields_;///< n x n_row per-particle values of the step
   // node accumulators and results
-  /// What each stencil entry adds to its node besides the loads, in one place (one cache line in
+  /// What each stencil entry adds to its node in the moment pass, in one place (one cache line in
   /// 2D): the moment matrix M of Eq. 9 (packed upper triangle), the largest W (Sec. 3.5) and the
   /// flag sum beta_i (Eq. 13).
   struct alignas(D == 2 ? 64 : 32) NodeSums {
@@ -258,7 +264,6 @@ class Integrator {
     double beta;
   };
   std::vector<NodeSums> sums_;
-  std::vector<double> load_;           ///< n_nodes x n_basis x n_row (l of Eq. 9, field fastest)
   std::vector<std::int32_t> count_;
   std::vector<Vec<D>> surface_sum_;    ///< sum S x over surface particles
   std::vector<double> surface_weight_; ///< sum S over surface particles
@@ -269,8 +274,11 @@ class Integrator {
   std::vector<Eigen::Matrix<double, D, D>> node_stress_power_;  ///< N_k of adjoint_point_stress
   std::vector<double> node_volume_;                           ///< W_k of adjoint_point_stress
   std::vector<std::uint8_t> held_;  ///< held_components()
-  std::vector<Eigen::Matrix<double, n_basis, n_basis>> inverse_;  ///< for gradients on request
-  std::vector<double> coef_;           ///< n_nodes x n_fields x n_basis: M^-1 l (Eq. 10), r in cells
+  /// n_nodes x n_coef_ x n_basis: the first n_coef_ rows of each node's M^-1 (Eq. 10).
+  std::vector<double> inverse_rows_;
+  /// n_nodes x n_coef_ x n_row (field fastest): c = M^-1 l of each field (Eq. 10), r in cells.
+  std::vector<double> coef_;
+  int n_coef_ = 1;  ///< coefficients fitted: 1 (the values) or n_basis (with the slopes)
   std::vector<std::uint8_t> alpha_;
   std::vector<std::uint8_t> live_;     ///< a particle reached the node at its last fit
   std::vector<double> distance_;

@@ -21,12 +21,14 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
     (void)grid;
   } else {
     const auto n_cells_total = static_cast<std::int64_t>(cell_begin_.size()) - 1;
-    auto cell_index = [&](std::int64_t c) {
+    auto cell_index = [&](std::int64_t c) {  // in 32 bits (faster divisions); the last axis is the quotient
       IVec<D> j;
-      for (int a = 0; a < D; ++a) {
-        j[a] = static_cast<int>(c % n_cells_[a]);
-        c /= n_cells_[a];
+      auto rest = static_cast<std::int32_t>(c);
+      for (int a = 0; a + 1 < D; ++a) {
+        j[a] = rest % n_cells_[a];
+        rest /= n_cells_[a];
       }
+      j[D - 1] = rest;
       return j;
     };
     // The inside regions of cell c from the distances at its corners (nodes, lower corner lo).
@@ -100,10 +102,9 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
             // reduced fit has zero slopes and gives its c0.
             Vec<D> r;
             for (int a = 0; a < D; ++a) r[a] = local[a] - ((k >> a) & 1);
-            const double* c = &coef_[static_cast<std::size_t>(node[k]) * n_fields * n_basis];
             auto at = [&](int field) {
-              double v = c[field * n_basis];
-              for (int a = 0; a < D; ++a) v += c[field * n_basis + 1 + a] * r[a];
+              double v = coefficient(node[k], field, 0);
+              for (int a = 0; a < D; ++a) v += coefficient(node[k], field, 1 + a) * r[a];
               return v;
             };
             q.density += S * at(D);
