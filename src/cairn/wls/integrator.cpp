@@ -106,6 +106,40 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   long long cells = 1;
   for (int a = 0; a < D; ++a) cells *= n_cells_[a];
   cell_begin_.assign(static_cast<std::size_t>(cells) + 1, 0);
+  // The cells by colour for the region scatters: the parity of the cell index along each axis,
+  // so that two cells of one colour are at least two apart and share no corner node; along a
+  // periodic axis with an odd number of cells (more than one) the last cell, whose upper nodes
+  // are cell 0's lower ones, takes a third colour.
+  std::array<int, D> colours{};
+  int n_colours = 1;
+  for (int a = 0; a < D; ++a) {
+    colours[a] = periodic_[a] && n_cells_[a] > 1 && n_cells_[a] % 2 == 1 ? 3 : 2;
+    n_colours *= colours[a];
+  }
+  colour_cells_.assign(static_cast<std::size_t>(n_colours), {});
+  for (std::int32_t c = 0; c < static_cast<std::int32_t>(cells); ++c) {
+    std::int32_t rest = c, colour = 0, scale = 1;
+    for (int a = 0; a < D; ++a) {
+      const std::int32_t j = a + 1 < D ? rest % n_cells_[a] : rest;
+      rest /= n_cells_[a];
+      colour += scale * (colours[a] == 3 && j == n_cells_[a] - 1 ? 2 : j % 2);
+      scale *= colours[a];
+    }
+    colour_cells_[static_cast<std::size_t>(colour)].push_back(c);
+  }
+}
+
+template <int D>
+template <class Fn>
+void Integrator<D>::for_each_region_coloured(Fn&& fn) const {
+  for (const std::vector<std::int32_t>& cells : colour_cells_) {
+    const auto n = static_cast<std::int64_t>(cells.size());
+#pragma omp parallel for schedule(static)
+    for (std::int64_t k = 0; k < n; ++k) {
+      const std::int32_t c = cells[static_cast<std::size_t>(k)];
+      for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) fn(r);
+    }
+  }
 }
 
 template <int D>
@@ -340,10 +374,12 @@ void Integrator<D>::adjoint_point_stress(const Grid<D>& grid, const Particles<D>
   node_volume_.resize(n_nodes);
   node_stress_power_.resize(n_nodes);
   for_each_node(n_nodes, [&](std::int32_t i) {
-    double w = 0.0;
-    for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>&) { w += S * q.volume; });
-    node_volume_[i] = w;
+    node_volume_[i] = 0.0;
     node_stress_power_[i].setZero();
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Corners& corner = corners_[r];
+    for (int k = 0; k < (1 << D); ++k) node_volume_[corner.node[k]] += corner.S[k] * regions_[r].volume;
   });
   scatter(cache_, [&](std::int32_t p, const auto&) {
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
@@ -493,25 +529,6 @@ void Integrator<D>::refine_distance(const Grid<D>& grid) {
 }
 
 template <int D>
-template <class Fn>
-void Integrator<D>::for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const {
-  const IVec<D> j = grid.multi_index(i);
-  for (int k = 0; k < (1 << D); ++k) {  // node i is corner k of the cell j - bits(k)
-    IVec<D> cell = j;
-    bool inside = true;
-    for (int a = 0; a < D; ++a) {
-      cell[a] -= (k >> a) & 1;
-      if (periodic_[a] && cell[a] < 0) cell[a] += n_cells_[a];  // node 0's lower cell: the last one
-      inside &= cell[a] >= 0 && cell[a] < n_cells_[a];
-    }
-    if (!inside) continue;
-    std::int64_t c = 0;
-    for (int a = D - 1; a >= 0; --a) c = c * n_cells_[a] + cell[a];
-    for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) fn(r, regions_[r], corners_[r].S[k], corners_[r].G[k]);
-  }
-}
-
-template <int D>
 void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes,
                               std::vector<Vec<D>>* node_body_force, bool surface_loads) {
   const std::int32_t n_nodes = grid.n_nodes();
@@ -520,22 +537,32 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     surface_force_.assign(n_nodes, Vec<D>::Zero());
     load_stamp_.assign(n_nodes, -1);
   }
-  // Eq. 22-24, gathered per node over the regions of the cells it is a corner of.
+  // Eq. 22-24, scattered from each region to its cell's corners (each region read once).
   for_each_node(n_nodes, [&](std::int32_t i) {
-    double m = 0.0;
-    Vec<D> fe = Vec<D>::Zero(), fi = Vec<D>::Zero(), a = Vec<D>::Zero();
-    for_each_region_of_node(grid, i, [&](std::int32_t, const Region<D>& q, double S, const Vec<D>& G) {
-      m += S * q.density * q.volume;         // Eq. 22
-      fe += S * q.volume * q.force_density;  // Eq. 23
-      fi -= q.volume * (q.stress * G);       // Eq. 24 (with sigma_q; Eq. 3's sign)
-      if (surface_loads) a += q.volume * G;  // Eq. 24's rule for a unit stress: the surface vector
-    });
-    if (surface_loads) surface_vector_[i] = a;
-    nodes.mass[i] = m;
-    nodes.momentum[i] = m * velocity_[i];
-    internal_force_[i] = fi;
-    nodes.force[i] = fe;
-    if (node_body_force) (*node_body_force)[i] = body_force ? fe : Vec<D>::Zero();
+    nodes.mass[i] = 0.0;
+    nodes.force[i].setZero();
+    internal_force_[i].setZero();
+    if (surface_loads) surface_vector_[i].setZero();
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Region<D>& q = regions_[r];
+    const Corners& corner = corners_[r];
+    const double m = q.density * q.volume;                        // Eq. 22
+    const Vec<D> fe = q.volume * q.force_density;                 // Eq. 23
+    const Eigen::Matrix<double, D, D> stress = q.volume * q.stress;  // Eq. 24 (with sigma_q; Eq. 3's sign)
+    for (int k = 0; k < (1 << D); ++k) {
+      const std::int32_t i = corner.node[k];
+      const double S = corner.S[k];
+      const Vec<D>& G = corner.G[k];
+      nodes.mass[i] += S * m;
+      nodes.force[i] += S * fe;
+      internal_force_[i] -= stress * G;
+      if (surface_loads) surface_vector_[i] += q.volume * G;  // Eq. 24's rule for a unit stress: the surface vector
+    }
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    nodes.momentum[i] = nodes.mass[i] * velocity_[i];
+    if (node_body_force) (*node_body_force)[i] = body_force ? nodes.force[i] : Vec<D>::Zero();
     if (!nodes.reaction.empty()) nodes.reaction[i].setZero();  // kept only where conditions record it
   });
   if (surface_loads) {
@@ -566,29 +593,27 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
 template <int D>
 void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
   // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
-  // (the strain rate the internal force of Eq. 24 is the power conjugate of) ...
-  const auto n_regions = static_cast<std::int64_t>(regions_.size());
-  region_gradient_.resize(regions_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t r = 0; r < n_regions; ++r) {
-    const Corners& corner = corners_[r];
-    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
-    region_gradient_[r] = L;
-  }
-  // ... and its S V-weighted mean over the integration points around each node.
+  // (the strain rate the internal force of Eq. 24 is the power conjugate of), and its S V-weighted
+  // mean over the integration points around each node, scattered to the corners.
   const std::int32_t n_nodes = grid.n_nodes();
   node_gradient_.resize(n_nodes);
   node_gradient_weight_.resize(n_nodes);
   for_each_node(n_nodes, [&](std::int32_t i) {
-    Eigen::Matrix<double, D, D> sum = Eigen::Matrix<double, D, D>::Zero();
-    double weight = 0.0;
-    for_each_region_of_node(grid, i, [&](std::int32_t r, const Region<D>& q, double S, const Vec<D>&) {
-      sum += S * q.volume * region_gradient_[r];
-      weight += S * q.volume;
-    });
-    node_gradient_[i] = weight > 0.0 ? Eigen::Matrix<double, D, D>(sum / weight) : sum;
-    node_gradient_weight_[i] = weight;
+    node_gradient_[i].setZero();
+    node_gradient_weight_[i] = 0.0;
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Corners& corner = corners_[r];
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
+    for (int k = 0; k < (1 << D); ++k) {
+      const double w = corner.S[k] * regions_[r].volume;
+      node_gradient_[corner.node[k]] += w * L;
+      node_gradient_weight_[corner.node[k]] += w;
+    }
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    if (node_gradient_weight_[i] > 0.0) node_gradient_[i] /= node_gradient_weight_[i];
   });
 }
 

@@ -239,9 +239,10 @@ class Integrator {
   void integrate(const Grid<D>& grid, bool body_force, NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force,
                  bool surface_loads);
   void spread_surface_loads(const Grid<D>& grid);
-  /// fn(region index, region, S_iq, G_iq) for every region in the cells node i is a corner of.
+  /// fn(region index) for every integration region, one colour of cells after the other: the
+  /// regions of one colour's cells share no corner node, so fn may add to its corners' nodes.
   template <class Fn>
-  void for_each_region_of_node(const Grid<D>& grid, std::int32_t i, Fn&& fn) const;
+  void for_each_region_coloured(Fn&& fn) const;
   void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
   void adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles);
 
@@ -293,6 +294,7 @@ class Integrator {
   double transfer_energy_ = 0.0;  ///< transfer_energy()
   // cells
   std::vector<std::int32_t> cell_begin_;  ///< n_cells_total + 1 offsets into regions_
+  std::vector<std::vector<std::int32_t>> colour_cells_;  ///< the cells by colour (constructor)
   std::vector<Region<D>> regions_;
   /// Per region its cell's corner nodes (bit a of k: upper along a) and their S, G at the point.
   struct Corners {
@@ -301,7 +303,6 @@ class Integrator {
     std::array<Vec<D>, (1 << D)> G;
   };
   std::vector<Corners> corners_;
-  std::vector<Eigen::Matrix<double, D, D>> region_gradient_;  ///< velocity gradient per region
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
   std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)
