@@ -118,11 +118,10 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   }
   colour_cells_.assign(static_cast<std::size_t>(n_colours), {});
   for (std::int32_t c = 0; c < static_cast<std::int32_t>(cells); ++c) {
-    std::int32_t rest = c, colour = 0, scale = 1;
+    const IVec<D> j = cell_index(c);
+    std::int32_t colour = 0, scale = 1;
     for (int a = 0; a < D; ++a) {
-      const std::int32_t j = a + 1 < D ? rest % n_cells_[a] : rest;
-      rest /= n_cells_[a];
-      colour += scale * (colours[a] == 3 && j == n_cells_[a] - 1 ? 2 : j % 2);
+      colour += scale * (colours[a] == 3 && j[a] == n_cells_[a] - 1 ? 2 : j[a] % 2);
       scale *= colours[a];
     }
     colour_cells_[static_cast<std::size_t>(colour)].push_back(c);

@@ -229,6 +229,16 @@ class Integrator {
   }
 
   void fit_nodes(const Grid<D>& grid);
+  /// Multi-index of cell c (linear, axis 0 fastest): D - 1 divisions, the last axis the quotient.
+  [[nodiscard]] IVec<D> cell_index(std::int32_t c) const {
+    IVec<D> j;
+    for (int a = 0; a + 1 < D; ++a) {
+      j[a] = c % n_cells_[a];
+      c /= n_cells_[a];
+    }
+    j[D - 1] = c;
+    return j;
+  }
   /// Coefficient c (0: the value, 1 + a: the slope along a, in cells) of field k's fit at node i.
   [[nodiscard]] double coefficient(std::int32_t i, int k, int c) const {
     return coef_[(static_cast<std::size_t>(i) * n_coef_ + c) * n_row + k];

@@ -21,20 +21,10 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
     (void)grid;
   } else {
     const auto n_cells_total = static_cast<std::int64_t>(cell_begin_.size()) - 1;
-    auto cell_index = [&](std::int64_t c) {  // in 32 bits (faster divisions); the last axis is the quotient
-      IVec<D> j;
-      auto rest = static_cast<std::int32_t>(c);
-      for (int a = 0; a + 1 < D; ++a) {
-        j[a] = rest % n_cells_[a];
-        rest /= n_cells_[a];
-      }
-      j[D - 1] = rest;
-      return j;
-    };
     // The inside regions of cell c from the distances at its corners (nodes, lower corner lo).
     auto cut = [&](std::int64_t c, std::array<std::int32_t, (1 << D)>& node, Vec<D>& lo,
                    std::array<CellRegion<D>, max_regions<D>>& out) {
-      const IVec<D> cell = cell_index(c);
+      const IVec<D> cell = cell_index(static_cast<std::int32_t>(c));
       std::array<double, (1 << D)> d;
       for (int k = 0; k < (1 << D); ++k) {
         IVec<D> j = cell;
