@@ -73,7 +73,8 @@ struct Options {
   bool every_symmetry_face_mirrors = true;
   /// Particle velocity gradient: true = from the integration points (sum_k v+_k (x) G_kq at each
   /// region, S V-averaged to the nodes, S-interpolated to the particle; docs/wls.md); false =
-  /// Eq. 29 as printed (sum_i v+_i (x) G_ip), unstable at free surfaces in our runs.
+  /// Eq. 29 as printed (sum_i v+_i (x) G_ip), whose strain rate is not the power conjugate of
+  /// Eq. 24: a free body gains energy at small steps (docs/wls.md, departure 4).
   bool quadrature_gradient = true;
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
   /// method.filter_acceleration: the step filters the grid velocity increments (docs/wls.md).

@@ -63,8 +63,9 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
     Key("", "velocity_gradient", KeyType::string,
       "WLS particle velocity gradient: quadrature = the gradients at the integration "
       "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
-      "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed, "
-      "unstable at free surfaces in our runs; docs/wls.md).")
+      "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed; its "
+      "strain rate is not the power conjugate of Eq. 24, and a free body gains energy at "
+      "small steps; docs/wls.md, departure 4).")
       .by_default("\"quadrature\"")
       .choices([] { return std::vector<std::string>{"quadrature", "narrow"}; }),
     Key("", "filter_acceleration", KeyType::boolean,
