@@ -610,14 +610,14 @@ double small_step_plate_drift(const std::string& gradient) {
 }
 
 TEST(WlsPatch, PrintedVelocityGradientGainsEnergyOnAFreePlateAtSmallSteps) {
-  // About 8 s. verification/plate_hole's WLS (Eq. 29 as printed, `velocity_gradient = "narrow"`,
+  // About 3 s. verification/plate_hole's WLS (Eq. 29 as printed, `velocity_gradient = "narrow"`,
   // with the fitted point values) on the freely vibrating plate at CFL 0.1: the semi-discrete
-  // system gains energy fast (measured: 12.9 E0 within two periods; at CFL 0.4 the steps'
-  // dissipation hides it, 2.2 % over a period in FreeVibrationEnergyOverAPeriod). With the
-  // quadrature gradient, whose strain rate is the power conjugate of Eq. 24, the same plate stays
-  // within 1.9 % over the two periods (it grows later: 1.48 E0 by four periods; with the node
-  // values 4.1 %, with the adjoint stress 2.4 %). The growth of the plate's hole stresses at
-  // h = 1/64 is this (docs/wls.md, departure 4).
+  // system gains energy fast (measured: max |E - E0| = 12.9 E0 within two periods; at CFL 0.4
+  // the steps' dissipation hides it, 2.2 % over a period in FreeVibrationEnergyOverAPeriod). With
+  // the quadrature gradient, whose strain rate is the power conjugate of Eq. 24, the same plate
+  // stays within 1.9 % over the two periods (it drifts later: max |E - E0| = 1.48 E0 by four
+  // periods; with the node values 4.1 %, with the adjoint stress 2.4 %). The growth of the
+  // plate's hole stresses at h = 1/64 is this (docs/wls.md, departure 4).
   const double narrow = small_step_plate_drift("narrow");
   const double quadrature = small_step_plate_drift("quadrature");
   const double gimp = small_step_plate_drift("");
