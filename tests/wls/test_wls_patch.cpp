@@ -529,9 +529,9 @@ double max_energy_drift(Simulation<2>& sim, double t_end) {
   return worst;
 }
 
-/// max |E(t) - E(0)| / E(0) of the quarter plate with the hole set vibrating by an initial
-/// velocity field (no load), over about one period of its breathing mode.
-double vibration_drift(const std::string& method) {
+/// The quarter plate with the hole set vibrating by an initial velocity field (no load): WLS
+/// (`method` "wls") or MPM with the shape `method`, central differences.
+Config vibrating_plate(const std::string& method) {
   Config c = patch_config("plate", 1.0 / 32);
   if (method != "wls") {
     c.method.integration = "mpm";
@@ -539,10 +539,17 @@ double vibration_drift(const std::string& method) {
   }
   c.method.time_integration = "central_difference";
   c.bodies[0].velocity = {"0.8 * X", "-0.5 * Y"};  // odd in X and Y: the symmetry planes hold
-  // E = 1e6, nu = 0.3, rho = 1000: c = sqrt((lambda + 3 mu) / rho) = 41.6; 4 (0.75) / c = 0.072.
-  const double period = 0.072;
-  Simulation<2> sim(c);
-  const double worst = max_energy_drift(sim, period);
+  return c;
+}
+
+/// Period of vibrating_plate's breathing mode: E = 1e6, nu = 0.3, rho = 1000 give
+/// c = sqrt((lambda + 3 mu) / rho) = 41.6, and 4 (0.75) / c = 0.072.
+constexpr double plate_period = 0.072;
+
+/// max |E(t) - E(0)| / E(0) of vibrating_plate over about one period.
+double vibration_drift(const std::string& method) {
+  Simulation<2> sim(vibrating_plate(method));
+  const double worst = max_energy_drift(sim, plate_period);
   std::printf("free vibration, %s: %lld steps to t = %.3f, max |E - E0| / E0 = %.4f\n", method.c_str(),
               static_cast<long long>(sim.step_count()), sim.time(), worst);
   return worst;
@@ -586,23 +593,18 @@ TEST(WlsPatch, FreeDiskKeepsItsEnergyAtSmallSteps) {
   EXPECT_GT(node, 0.20);
 }
 
-/// max |E(t) - E(0)| / E(0) of the vibrating quarter plate of vibration_drift at CFL 0.1 over two
-/// periods: WLS with the integration points' fitted values (`point_values = "fit"`, as
-/// verification/plate_hole) and the given velocity gradient, or cpGIMP (`gradient` empty).
+/// max |E(t) - E(0)| / E(0) of vibrating_plate at CFL 0.1 over two periods: WLS with the
+/// integration points' fitted values (`point_values = "fit"`, as verification/plate_hole) and the
+/// given velocity gradient, or cpGIMP (`gradient` empty).
 double small_step_plate_drift(const std::string& gradient) {
-  Config c = patch_config("plate", 1.0 / 32);
-  c.method.time_integration = "central_difference";
-  if (gradient.empty()) {
-    c.method.integration = "mpm";
-    c.method.shape = "cpgimp";
-  } else {
+  Config c = vibrating_plate(gradient.empty() ? "cpgimp" : "wls");
+  if (!gradient.empty()) {
     c.method.plugin.set("point_values", std::string("fit"));
     c.method.plugin.set("velocity_gradient", gradient);
   }
-  c.bodies[0].velocity = {"0.8 * X", "-0.5 * Y"};
   c.simulation.cfl = 0.1;
   Simulation<2> sim(c);
-  const double worst = max_energy_drift(sim, 2 * 0.072);
+  const double worst = max_energy_drift(sim, 2 * plate_period);
   std::printf("free plate, CFL 0.1, %s: %lld steps to t = %.3f, max |E - E0| / E0 = %.4f\n",
               gradient.empty() ? "cpGIMP" : ("WLS, velocity_gradient = " + gradient).c_str(),
               static_cast<long long>(sim.step_count()), sim.time(), worst);
