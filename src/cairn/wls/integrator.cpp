@@ -87,9 +87,11 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
   }
   const std::int32_t n = grid.n_nodes();
   sums_.assign(n, NodeSums{});
-  // The slopes of the fits are read only by the fitted point values and the extrapolated
-  // spurious velocity; otherwise the values c0 alone are formed (Eq. 11).
-  n_coef_ = options.fitted_point_values || options.extrapolated_spurious_velocity ? n_basis : 1;
+  // The slopes of the fits are read only by the fitted point values, the extrapolated spurious
+  // velocity and the fitted surface velocity; otherwise the values c0 alone are formed (Eq. 11).
+  n_coef_ = options.fitted_point_values || options.extrapolated_spurious_velocity || options.fitted_surface_velocity
+                ? n_basis
+                : 1;
   coef_.assign(static_cast<std::size_t>(n) * n_coef_ * n_row, 0.0);
   inverse_rows_.assign(static_cast<std::size_t>(n) * n_coef_ * n_basis, 0.0);
   count_.assign(n, 0);
@@ -625,6 +627,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const bool from_quadrature = options_.quadrature_gradient;
   const bool pic = options_.pic_velocity;
   const bool all_nodes = options_.massless_corners_included;
+  const bool fitted_surface = options_.fitted_surface_velocity;
   if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
@@ -695,9 +698,13 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       }
     }
     if (from_quadrature && weight > 0.0) L /= weight;
-    // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11).
+    // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11). A
+    // surface particle may start from the fitted velocity at its position instead of its own.
     const double before = particles.velocity[p].squaredNorm();
-    particles.velocity[p] = pic ? vx : Vec<D>(particles.velocity[p] + dv);
+    const Vec<D> start = fitted_surface && is_surface(particles, static_cast<std::size_t>(p))
+                             ? fitted_velocity(grid, axis_node, axis_S, particles.position[p], particles.velocity[p])
+                             : particles.velocity[p];
+    particles.velocity[p] = pic ? vx : Vec<D>(start + dv);
     particles.position[p] += vx * dt;
     particle_gradient_[p] = L;
     return 0.5 * particles.mass[p] * (particles.velocity[p].squaredNorm() - before);
@@ -714,6 +721,26 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const ExactSum particle_change = gather_sum(cache_, move);
   grid_work_ += grid_change.value();
   transfer_energy_ += particle_change.value() - grid_change.value();
+}
+
+template <int D>
+Vec<D> Integrator<D>::fitted_velocity(const Grid<D>& grid, const std::int32_t* axis_node, const double* axis_S,
+                                      const Vec<D>& x, const Vec<D>& otherwise) const {
+  // The well-conditioned corners' planar velocity fits (velocity component a is field a) at x,
+  // S-weighted (docs/wls.md, departure 16); `otherwise` where no corner is well conditioned.
+  Vec<D> sum = Vec<D>::Zero();
+  double weight = 0.0;
+  for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) {
+    double S;
+    const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
+    if (S == 0.0 || !alpha_[i]) return;
+    Vec<D> r = (x - grid.node_position(i)).cwiseQuotient(h_);
+    for (int a = 0; a < D; ++a)  // along a periodic axis, the node's image next to x
+      if (periodic_[a]) r[a] -= n_cells_[a] * std::round(r[a] / n_cells_[a]);
+    for (int a = 0; a < D; ++a) sum[a] += S * fit_at(i, a, r);
+    weight += S;
+  });
+  return weight > 0.0 ? Vec<D>(sum / weight) : otherwise;
 }
 
 template <int D>

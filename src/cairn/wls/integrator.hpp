@@ -85,6 +85,11 @@ struct Options {
   /// Particle velocity update: false = Eq. 27 as printed, V_p += sum S_ip (v+_i - v_i) (FLIP);
   /// true = V_p = sum S_ip v+_i (PIC, seed 002 Eq. 1.66 without damping; docs/wls.md).
   bool pic_velocity = false;
+  /// Velocity of the surface particles (zero mass) before Eq. 27's increment: false = their own
+  /// (as printed); true = the S-weighted planar velocity fits (Eq. 10) of the well-conditioned
+  /// corners of their cell at their position, so that a massless point keeps no velocity of its
+  /// own for the next fits to read (docs/wls.md, departure 16).
+  bool fitted_surface_velocity = false;
   /// Nodes without mass in a particle's Eq. 27-28 (S_ip > 0: corners of its cell that no
   /// integration region reaches): false = they take, for the particle, the S-weighted mean of the
   /// corners with mass (the partition of unity kept; docs/wls.md, departure 12); true = their
@@ -244,6 +249,14 @@ class Integrator {
   [[nodiscard]] double coefficient(std::int32_t i, int k, int c) const {
     return coef_[(static_cast<std::size_t>(i) * n_coef_ + c) * n_row + k];
   }
+  /// Field k's planar fit at node i (Eq. 10) evaluated at r = (x - x_i) / h, in cells; its value
+  /// c0 where the slopes are not formed (n_coef_ = 1) or the fit is reduced (zero slopes).
+  [[nodiscard]] double fit_at(std::int32_t i, int k, const Vec<D>& r) const {
+    double v = coefficient(i, k, 0);
+    if (n_coef_ > 1)
+      for (int a = 0; a < D; ++a) v += coefficient(i, k, 1 + a) * r[a];
+    return v;
+  }
   void extrapolate_spurious_velocity(const Grid<D>& grid);
   void refine_distance(const Grid<D>& grid);
   void build_regions(const Grid<D>& grid);
@@ -256,6 +269,9 @@ class Integrator {
   void for_each_region_coloured(Fn&& fn) const;
   void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
   void adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles);
+  /// The fitted velocity at x of a particle with stencil (axis_node, axis_S) (move_particles).
+  Vec<D> fitted_velocity(const Grid<D>& grid, const std::int32_t* axis_node, const double* axis_S, const Vec<D>& x,
+                         const Vec<D>& otherwise) const;
 
   Options options_;
   Vec<D> h_;

@@ -19,6 +19,7 @@ Options options(const MethodConfig& method) {
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
   o.hourglass_damping = method.plugin.real("hourglass_damping");
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
+  o.fitted_surface_velocity = method.plugin.text("surface_velocity") == "fit";
   o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
   o.every_symmetry_face_mirrors = method.plugin.text("mirror_planes") == "all";
   o.energy_budget = method.plugin.boolean("energy_budget");
@@ -97,6 +98,13 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "(docs/wls.md).")
       .by_default("\"flip\"")
       .choices([] { return std::vector<std::string>{"flip", "pic"}; }),
+    Key("", "surface_velocity", KeyType::string,
+      "WLS velocity of the surface particles (zero mass) before the increment of Eq. 27: "
+      "own = the particle's own velocity (as printed); fit = the planar velocity fits of the "
+      "well-conditioned corners of its cell at its position, S-weighted, so that a massless "
+      "point carries no velocity of its own into the next fits (docs/wls.md, departure 16).")
+      .by_default("\"own\"")
+      .choices([] { return std::vector<std::string>{"own", "fit"}; }),
     Key("", "empty_corners", KeyType::string,
       "WLS particle update at corners of the particle's cell that carry no mass (no "
       "integration region reaches them: the particle lies on or beyond the cut surface): "

@@ -92,11 +92,7 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
             // reduced fit has zero slopes and gives its c0.
             Vec<D> r;
             for (int a = 0; a < D; ++a) r[a] = local[a] - ((k >> a) & 1);
-            auto at = [&](int field) {
-              double v = coefficient(node[k], field, 0);
-              for (int a = 0; a < D; ++a) v += coefficient(node[k], field, 1 + a) * r[a];
-              return v;
-            };
+            auto at = [&](int field) { return fit_at(node[k], field, r); };
             q.density += S * at(D);
             for (int a = 0; a < D; ++a) {
               q.force_density[a] += S * at(D + 1 + n_stress + a);
