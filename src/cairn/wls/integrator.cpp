@@ -495,10 +495,7 @@ void Integrator<D>::extrapolate_spurious_velocity(const Grid<D>& grid) {
     int n = 0;
     for_each_neighbour(grid, i, [&](std::int32_t nb, const Vec<D>& offset) {
       if (!alpha_[nb]) return;
-      for (int a = 0; a < D; ++a) {  // velocity component a is field a; x_i - x_nb = -offset
-        sum[a] += coefficient(nb, a, 0);
-        for (int b = 0; b < D; ++b) sum[a] -= coefficient(nb, a, 1 + b) * offset[b];
-      }
+      for (int a = 0; a < D; ++a) sum[a] += fit_at(nb, a, -offset);  // component a is field a; x_i - x_nb = -offset
       ++n;
     });
     if (n > 0) filtered_[i] = sum / n;
@@ -726,7 +723,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
 template <int D>
 Vec<D> Integrator<D>::fitted_velocity(const Grid<D>& grid, const std::int32_t* axis_node, const double* axis_S,
                                       const Vec<D>& x, const Vec<D>& otherwise) const {
-  // The well-conditioned corners' planar velocity fits (velocity component a is field a) at x,
+  // The well-conditioned corners' planar velocity fits (seed 001 Eq. 10; component a is field a) at x,
   // S-weighted (docs/wls.md, departure 16); `otherwise` where no corner is well conditioned.
   Vec<D> sum = Vec<D>::Zero();
   double weight = 0.0;

@@ -249,7 +249,7 @@ class Integrator {
   [[nodiscard]] double coefficient(std::int32_t i, int k, int c) const {
     return coef_[(static_cast<std::size_t>(i) * n_coef_ + c) * n_row + k];
   }
-  /// Field k's planar fit at node i (Eq. 10) evaluated at r = (x - x_i) / h, in cells; its value
+  /// Field k's planar fit at node i (seed 001 Eq. 10) evaluated at r = (x - x_i) / h, in cells; its value
   /// c0 where the slopes are not formed (n_coef_ = 1) or the fit is reduced (zero slopes).
   [[nodiscard]] double fit_at(std::int32_t i, int k, const Vec<D>& r) const {
     double v = coefficient(i, k, 0);
