@@ -616,17 +616,87 @@ void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<
 }
 
 template <int D>
+void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
+  // sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k) with
+  // beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc = sum_p psi_kcp
+  // sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc with
+  // A_kc = sum_q (V_q / s_q) S_kq beta_c L_q, the node sums formed here (race-free by colour).
+  const int n_c = options_.fitted_point_values ? n_basis : 1;
+  const auto n_nodes = static_cast<std::int32_t>(alpha_.size());
+  transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+  transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    for (int c = 0; c < n_basis; ++c) {
+      transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
+      transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
+    }
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Corners& corner = corners_[r];
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
+    double sum = 0.0;
+    const unsigned used = value_corners(corner, sum);
+    const double scale = regions_[r].volume / sum;
+    // The point in its cell, in cells from the lower corner (as build_regions places it).
+    const Vec<D> lo = grid.origin() + cell_index(regions_[r].cell).template cast<double>().cwiseProduct(h_);
+    const Vec<D> local = (regions_[r].centroid - lo).cwiseProduct(h_.cwiseInverse());
+    for (int k = 0; k < (1 << D); ++k) {
+      if (!(used >> k & 1U)) continue;
+      const std::size_t at = static_cast<std::size_t>(corner.node[k]) * n_basis;
+      const double w = scale * corner.S[k];
+      for (int c = 0; c < n_c; ++c) {
+        const double beta = c == 0 ? 1.0 : local[c - 1] - ((k >> (c - 1)) & 1);
+        transpose_sum_[at + c] += (w * beta) * L;
+        transpose_weight_[at + c] += w * beta;
+      }
+    }
+  });
+}
+
+template <int D>
+Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p, double& weight) const {
+  // psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over the particle's wide stencil.
+  const int n_c = options_.fitted_point_values ? n_basis : 1;
+  const std::size_t q = p * D * 3;
+  const std::int32_t* axis_node = &cache_.axis_node[q];
+  const double* axis_W = &wide_[q];
+  const double* axis_r = &offset_[q];
+  Eigen::Matrix<double, D, D> G = Eigen::Matrix<double, D, D>::Zero();
+  weight = 0.0;
+  for_each_slot<D>([&](const std::array<int, D>& k) {
+    double W;
+    const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
+    if (W <= 0.0) return;
+    const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];
+    const std::size_t at = static_cast<std::size_t>(i) * n_basis;
+    for (int c = 0; c < n_c; ++c) {
+      double psi = rows[c * n_basis];
+      for (int a = 0; a < D; ++a) psi += rows[c * n_basis + 1 + a] * axis_r[3 * a + k[a]];
+      psi *= W;
+      G += psi * transpose_sum_[at + c];
+      weight += psi * transpose_weight_[at + c];
+    }
+  });
+  return G;
+}
+
+template <int D>
 void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles,
                                    double dt, const std::vector<std::uint8_t>* held) {
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
   const auto& mass = nodes.mass;
-  const bool from_quadrature = options_.quadrature_gradient;
+  const bool transpose = options_.transpose_gradient;
+  // The quadrature gradient is also the transposed gradient's fallback.
+  const bool from_quadrature = options_.quadrature_gradient || transpose;
   const bool pic = options_.pic_velocity;
   const bool all_nodes = options_.massless_corners_included;
   const bool fitted_surface = options_.fitted_surface_velocity;
   if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
+  if (transpose) transpose_gradients(grid, v_new);
   particle_gradient_.resize(particles.n());
   // Eq. 27-29 for particle p; returns its kinetic energy change (the energy budget's sum).
   const auto move = [&](std::int64_t p, const auto&) {
@@ -695,6 +765,16 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       }
     }
     if (from_quadrature && weight > 0.0) L /= weight;
+    if (transpose && !is_surface(particles, static_cast<std::size_t>(p))) {
+      // The transpose of the stress transfer (docs/wls.md, departure 17), where its weight is a
+      // volume near the particle's own: a massless surface particle stores no power, and where
+      // the fits extrapolate (cells that a mirror plane fills up to a wall) the weight can be
+      // small or negative.
+      double w = 0.0;
+      const Eigen::Matrix<double, D, D> G = transposed_gradient_sum(static_cast<std::size_t>(p), w);
+      const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
+      if (w > V / transpose_band && w < V * transpose_band) L = G / w;
+    }
     // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11). A
     // surface particle may start from the fitted velocity at its position instead of its own.
     const double before = particles.velocity[p].squaredNorm();

@@ -76,6 +76,14 @@ struct Options {
   /// Eq. 29 as printed (sum_i v+_i (x) G_ip), whose strain rate is not the power conjugate of
   /// Eq. 24: a free body gains energy at small steps (docs/wls.md, departure 4).
   bool quadrature_gradient = true;
+  /// Particle velocity gradient (method.velocity_gradient = "transpose", docs/wls.md departure
+  /// 17): the transpose of the stress transfer of Eq. 19-21 (the node fits, then the point values
+  /// at the integration points), normalised: L_p = sum_q V_q T_qp L_q / sum_q V_q T_qp, where
+  /// sigma_q = sum_p T_qp sigma_p and L_q = sum_k v+_k (x) G_kq. The particles then store the power
+  /// Eq. 24's internal force takes from the grid wherever sum_q V_q T_qp = V_p. Surface particles
+  /// and particles whose sum_q V_q T_qp is not within a factor transpose_band of V_p take the
+  /// quadrature gradient. quadrature_gradient is false with it.
+  bool transpose_gradient = false;
   double thickness = 1.0;          ///< out-of-plane thickness in 2D (volumes and masses)
   /// method.filter_acceleration: the step filters the grid velocity increments (docs/wls.md).
   bool filter_acceleration = false;
@@ -217,6 +225,13 @@ class Integrator {
   [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
     return particle_gradient_;
   }
+  /// For transpose_gradient: particle p's sum_q V_q T_qp L_q over the integration points of the
+  /// last move_particles, and in `weight` sum_q V_q T_qp (T_qp: particle p's weight in the stress
+  /// sigma_q of Eq. 19-21, L_q the grid velocity gradient at q). Summed over every particle,
+  /// sum_p sigma_p : G_p is the power sum_q V_q sigma_q : L_q of Eq. 24's forces.
+  [[nodiscard]] Eigen::Matrix<double, D, D> transposed_gradient_sum(std::size_t p, double& weight) const;
+  /// A particle takes the transposed gradient when its weight lies within this factor of V_p.
+  static constexpr double transpose_band = 4.0;
 
  private:
   static constexpr int n_basis = D + 1;
@@ -268,6 +283,9 @@ class Integrator {
   template <class Fn>
   void for_each_region_coloured(Fn&& fn) const;
   void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
+  /// transposed_gradient_sum's node sums: per node k and fit coefficient c,
+  /// sum_q (V_q / s_q) S_kq beta_c(x_q - x_k) L_q over the points whose value reads node k's fit.
+  void transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
   void adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles);
   /// The fitted velocity at x of a particle with stencil (axis_node, axis_S) (move_particles).
   Vec<D> fitted_velocity(const Grid<D>& grid, const std::int32_t* axis_node, const double* axis_S, const Vec<D>& x,
@@ -330,6 +348,23 @@ class Integrator {
     std::array<Vec<D>, (1 << D)> G;
   };
   std::vector<Corners> corners_;
+  /// The corners whose fits give a region's values (Eq. 19-21: the well-conditioned ones, or all
+  /// where none is; bit k for corner k), and in `sum` their sum of S_kq: the rule build_regions'
+  /// two passes apply (TransposedGradientSumsAreThePowerOfTheForces fails where they differ).
+  [[nodiscard]] unsigned value_corners(const Corners& corner, double& sum) const {
+    unsigned mask = 0;
+    sum = 0.0;
+    for (int k = 0; k < (1 << D); ++k)
+      if (alpha_[corner.node[k]]) {
+        mask |= 1U << k;
+        sum += corner.S[k];
+      }
+    if (sum > 0.0) return mask;
+    for (int k = 0; k < (1 << D); ++k) sum += corner.S[k];
+    return (1U << (1 << D)) - 1;
+  }
+  std::vector<Eigen::Matrix<double, D, D>> transpose_sum_;      ///< n_nodes x n_basis (transpose_gradients)
+  std::vector<double> transpose_weight_;                        ///< the same sums without L_q
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
   std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)

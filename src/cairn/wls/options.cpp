@@ -16,6 +16,7 @@ Options options(const MethodConfig& method) {
   o.adjoint_point_stress = method.plugin.text("point_values") == "adjoint";
   o.extrapolated_spurious_velocity = method.plugin.text("spurious_velocity") == "neighbours";
   o.quadrature_gradient = method.plugin.text("velocity_gradient") == "quadrature";
+  o.transpose_gradient = method.plugin.text("velocity_gradient") == "transpose";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
   o.hourglass_damping = method.plugin.real("hourglass_damping");
   o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
@@ -66,9 +67,12 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "points (the strain rate conjugate to Eq. 24), averaged to the nodes and "
       "interpolated with S; narrow = sum v_i (x) G_ip (seed 001 Eq. 29 as printed; its "
       "strain rate is not the power conjugate of Eq. 24, and a free body gains energy at "
-      "small steps; docs/wls.md, departure 4).")
+      "small steps; docs/wls.md, departure 4); transpose = the transpose of the stress "
+      "transfer of Eq. 19-21, normalised, so that the particles store the power the "
+      "internal force takes from the grid (surface particles: quadrature; docs/wls.md, "
+      "departure 17).")
       .by_default("\"quadrature\"")
-      .choices([] { return std::vector<std::string>{"quadrature", "narrow"}; }),
+      .choices([] { return std::vector<std::string>{"quadrature", "narrow", "transpose"}; }),
     Key("", "filter_acceleration", KeyType::boolean,
       "WLS: replace each node's velocity increment a dt by the planar least-squares "
       "fit over it and its neighbours with mass (weights W m), so linear fields pass "
