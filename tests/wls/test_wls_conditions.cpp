@@ -497,30 +497,35 @@ TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
 TEST(WlsConditions, OddPeriodicAxisIsBitIdenticalForAnyThreadCount) {
   // 21 cells along the periodic x axis: the region scatters give the last cell, whose upper nodes
   // are cell 0's lower ones, a colour of its own (Integrator constructor). A body across the seam,
-  // in 1, 2 and 3 threads.
-  Config c = periodic_config(2, 0.0);
-  c.grid.extent[0] = 1.05;
-  c.bodies.resize(2, c.bodies[0]);
-  c.bodies[0].shape.min[0] = 0.8;
-  c.bodies[0].shape.max[0] = 1.05;
-  c.bodies[1].name = "wrapped";
-  c.bodies[1].shape.min[0] = 0.0;
-  c.bodies[1].shape.max[0] = 0.2;
-  std::vector<Particles<2>> results;
-  for (const int threads : {1, 2, 3}) {
-    c.simulation.threads = threads;
-    Simulation<2> sim(c);
-    ASSERT_EQ(sim.grid().n_cells()[0], 21);
-    for (int s = 0; s < 40; ++s) sim.step(sim.next_dt());
-    results.push_back(sim.particles());
-  }
-  omp_set_num_threads(omp_get_num_procs());
-  for (std::size_t r = 1; r < results.size(); ++r)
-    for (std::size_t p = 0; p < results[0].n(); ++p) {
-      ASSERT_EQ(results[r].position[p], results[0].position[p]) << r << " " << p;
-      ASSERT_EQ(results[r].velocity[p], results[0].velocity[p]) << r << " " << p;
-      ASSERT_EQ(results[r].kirchhoff_stress[p], results[0].kirchhoff_stress[p]) << r << " " << p;
+  // in 1, 2 and 3 threads; with the default gradient and the transposed one (its node sums are
+  // region scatters too).
+  for (const std::string gradient : {"quadrature", "transpose"}) {
+    Config c = periodic_config(2, 0.0);
+    c.method.plugin.set("velocity_gradient", gradient);
+    c.grid.extent[0] = 1.05;
+    c.bodies.resize(2, c.bodies[0]);
+    c.bodies[0].shape.min[0] = 0.8;
+    c.bodies[0].shape.max[0] = 1.05;
+    c.bodies[1].name = "wrapped";
+    c.bodies[1].shape.min[0] = 0.0;
+    c.bodies[1].shape.max[0] = 0.2;
+    std::vector<Particles<2>> results;
+    for (const int threads : {1, 2, 3}) {
+      c.simulation.threads = threads;
+      Simulation<2> sim(c);
+      ASSERT_EQ(sim.grid().n_cells()[0], 21);
+      for (int s = 0; s < 40; ++s) sim.step(sim.next_dt());
+      results.push_back(sim.particles());
     }
+    omp_set_num_threads(omp_get_num_procs());
+    for (std::size_t r = 1; r < results.size(); ++r)
+      for (std::size_t p = 0; p < results[0].n(); ++p) {
+        ASSERT_EQ(results[r].position[p], results[0].position[p]) << gradient << " " << r << " " << p;
+        ASSERT_EQ(results[r].velocity[p], results[0].velocity[p]) << gradient << " " << r << " " << p;
+        ASSERT_EQ(results[r].kirchhoff_stress[p], results[0].kirchhoff_stress[p])
+            << gradient << " " << r << " " << p;
+      }
+  }
 }
 
 TEST(WlsConditions, PeriodicAxisNeedsThreeCells) {

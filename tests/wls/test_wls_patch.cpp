@@ -726,12 +726,12 @@ TEST(WlsPatch, PrintedVelocityGradientGainsEnergyOnAFreePlateAtSmallSteps) {
 }
 
 TEST(WlsPatch, TransposedGradientKeepsFreeBodiesEnergyAtSmallSteps) {
-  // About 6 s. With the transposed gradient (docs/wls.md, departure 17) the particles store the
+  // About 3 s. With the transposed gradient (docs/wls.md, departure 17) the particles store the
   // power the internal force takes from the grid (TransposedGradientSumsAreThePowerOfTheForces):
   // the free disk of FreeDiskKeepsItsEnergyAtSmallSteps, with the node values of Eq. 21 and the
   // surface particles' own velocities, stays within 1.9 % to t = 5 (measured; 35.7 % with the
   // quadrature gradient), and the free plate with the hole, whose Eq. 29 gains 12.9 E0, within
-  // 1.6 % over two periods (measured, with the fitted values, as the case runs them).
+  // 0.6 % over two periods (measured, with the fitted values, as the case runs them).
   EXPECT_LT(free_disk_drift("node", "own", "transpose"), 0.05);
   EXPECT_LT(small_step_plate_drift("transpose"), 0.05);
 }

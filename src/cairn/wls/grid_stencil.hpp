@@ -1,5 +1,6 @@
 // Grid stencils shared by the WLS integrator's stages (internal to src/cairn/wls): the 3^D block
-// of nodes around a node and the narrow cell-corner shape of seed 001 Eq. 5-6.
+// of nodes around a node, the narrow cell-corner shape of seed 001 Eq. 5-6, and the walks over a
+// particle's stored stencil (Integrator::build_stencils' tensor layout).
 #pragma once
 
 #include <array>
@@ -72,5 +73,60 @@ void for_each_corner_at(const Grid<D>& grid, const Vec<D>& x, const Vec<D>& inv_
     fn(node, S, G);
   }
 }
+
+/// fn(k) for the 3^D entries k (the node index along each axis, 0..2) of a WLS stencil, axis 0
+/// fastest: the order of the sums, the same for every particle. Inlined with its callers' bodies
+/// (GCC kept them out of line, with every captured pointer reloaded per entry).
+template <int D, class Fn>
+[[gnu::always_inline]] inline void for_each_slot(Fn&& fn) {
+  if constexpr (D == 1) {
+    for (int i = 0; i < 3; ++i) fn(std::array<int, 1>{i});
+  } else if constexpr (D == 2) {
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) fn(std::array<int, 2>{i, j});
+  } else {
+    for (int l = 0; l < 3; ++l)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) fn(std::array<int, 3>{i, j, l});
+  }
+}
+
+/// fn(k) for the 2^D entries of a WLS stencil where the narrow shape S (Eq. 5) and its gradient
+/// (Eq. 6) can be nonzero: the corners of the particle's cell, entries first..first + 1 along each
+/// axis, with first = 0 where S[0] != 0 (build_stencils: shift 1, x_p in the cell's upper half)
+/// and 1 otherwise. The other entries give S = G = 0 exactly, so the sums skip only zero terms.
+template <int D, class Fn>
+[[gnu::always_inline]] inline void for_each_corner_slot(const double* axis_S, Fn&& fn) {
+  int first[D];
+  for (int a = 0; a < D; ++a) first[a] = axis_S[6 * a] != 0.0 ? 0 : 1;
+  if constexpr (D == 1) {
+    for (int i = 0; i < 2; ++i) fn(std::array<int, 1>{first[0] + i});
+  } else if constexpr (D == 2) {
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) fn(std::array<int, 2>{first[0] + i, first[1] + j});
+  } else {
+    for (int l = 0; l < 2; ++l)
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) fn(std::array<int, 3>{first[0] + i, first[1] + j, first[2] + l});
+  }
+}
+
+/// Stencil entry k of a particle in the tensor layout of build_stencils: its node's storage index
+/// (the sum of the axes' offsets) and the product of its per-axis factors, `stride` apart per
+/// axis (3 for the wide W, 6 for the narrow S whose gradients follow each axis's values).
+template <int D, int stride>
+[[gnu::always_inline]] inline std::int32_t stencil_entry(const std::array<int, D>& k, const std::int32_t* axis_node,
+                                                         const double* axis_factor, double& product) {
+  std::int32_t i = 0;
+  product = 1.0;
+  for (int a = 0; a < D; ++a) {
+    i += axis_node[3 * a + k[a]];
+    product *= axis_factor[stride * a + k[a]];
+  }
+  return i;
+}
+
+/// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
+constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
 
 }  // namespace cairn::wls::detail

@@ -19,62 +19,11 @@ namespace cairn::wls {
 namespace {
 
 using detail::for_each_corner_at;
+using detail::for_each_corner_slot;
 using detail::for_each_neighbour;
-
-/// fn(k) for the 3^D entries k (the node index along each axis, 0..2) of a WLS stencil, axis 0
-/// fastest: the order of the sums, the same for every particle. Inlined with its callers' bodies
-/// (GCC kept them out of line, with every captured pointer reloaded per entry).
-template <int D, class Fn>
-[[gnu::always_inline]] inline void for_each_slot(Fn&& fn) {
-  if constexpr (D == 1) {
-    for (int i = 0; i < 3; ++i) fn(std::array<int, 1>{i});
-  } else if constexpr (D == 2) {
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) fn(std::array<int, 2>{i, j});
-  } else {
-    for (int l = 0; l < 3; ++l)
-      for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i) fn(std::array<int, 3>{i, j, l});
-  }
-}
-
-/// fn(k) for the 2^D entries of a WLS stencil where the narrow shape S (Eq. 5) and its gradient
-/// (Eq. 6) can be nonzero: the corners of the particle's cell, entries first..first + 1 along each
-/// axis, with first = 0 where S[0] != 0 (build_stencils: shift 1, x_p in the cell's upper half)
-/// and 1 otherwise. The other entries give S = G = 0 exactly, so the sums skip only zero terms.
-template <int D, class Fn>
-[[gnu::always_inline]] inline void for_each_corner_slot(const double* axis_S, Fn&& fn) {
-  int first[D];
-  for (int a = 0; a < D; ++a) first[a] = axis_S[6 * a] != 0.0 ? 0 : 1;
-  if constexpr (D == 1) {
-    for (int i = 0; i < 2; ++i) fn(std::array<int, 1>{first[0] + i});
-  } else if constexpr (D == 2) {
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) fn(std::array<int, 2>{first[0] + i, first[1] + j});
-  } else {
-    for (int l = 0; l < 2; ++l)
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) fn(std::array<int, 3>{first[0] + i, first[1] + j, first[2] + l});
-  }
-}
-
-/// Stencil entry k of a particle in the tensor layout of build_stencils: its node's storage index
-/// (the sum of the axes' offsets) and the product of its per-axis factors, `stride` apart per
-/// axis (3 for the wide W, 6 for the narrow S whose gradients follow each axis's values).
-template <int D, int stride>
-[[gnu::always_inline]] inline std::int32_t stencil_entry(const std::array<int, D>& k, const std::int32_t* axis_node,
-                                                         const double* axis_factor, double& product) {
-  std::int32_t i = 0;
-  product = 1.0;
-  for (int a = 0; a < D; ++a) {
-    i += axis_node[3 * a + k[a]];
-    product *= axis_factor[stride * a + k[a]];
-  }
-  return i;
-}
-
-/// Index of entry (r, c), r <= c, of the packed upper triangle of an n x n symmetric matrix.
-constexpr int packed(int r, int c, int n) { return r * n - r * (r - 1) / 2 + (c - r); }
+using detail::for_each_slot;
+using detail::packed;
+using detail::stencil_entry;
 
 }  // namespace
 
@@ -127,19 +76,6 @@ Integrator<D>::Integrator(const Grid<D>& grid, const Options& options)
       scale *= colours[a];
     }
     colour_cells_[static_cast<std::size_t>(colour)].push_back(c);
-  }
-}
-
-template <int D>
-template <class Fn>
-void Integrator<D>::for_each_region_coloured(Fn&& fn) const {
-  for (const std::vector<std::int32_t>& cells : colour_cells_) {
-    const auto n = static_cast<std::int64_t>(cells.size());
-#pragma omp parallel for schedule(static)
-    for (std::int64_t k = 0; k < n; ++k) {
-      const std::int32_t c = cells[static_cast<std::size_t>(k)];
-      for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) fn(r);
-    }
   }
 }
 
@@ -586,100 +522,6 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
     }
     nodes.force[i] += fi;
   });
-}
-
-template <int D>
-void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
-  // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
-  // (the strain rate the internal force of Eq. 24 is the power conjugate of), and its S V-weighted
-  // mean over the integration points around each node, scattered to the corners.
-  const std::int32_t n_nodes = grid.n_nodes();
-  node_gradient_.resize(n_nodes);
-  node_gradient_weight_.resize(n_nodes);
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    node_gradient_[i].setZero();
-    node_gradient_weight_[i] = 0.0;
-  });
-  for_each_region_coloured([&](std::int32_t r) {
-    const Corners& corner = corners_[r];
-    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
-    for (int k = 0; k < (1 << D); ++k) {
-      const double w = corner.S[k] * regions_[r].volume;
-      node_gradient_[corner.node[k]] += w * L;
-      node_gradient_weight_[corner.node[k]] += w;
-    }
-  });
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    if (node_gradient_weight_[i] > 0.0) node_gradient_[i] /= node_gradient_weight_[i];
-  });
-}
-
-template <int D>
-void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
-  // Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
-  // sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k) with
-  // beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc = sum_p psi_kcp
-  // sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc with
-  // A_kc = sum_q (V_q / s_q) S_kq beta_c L_q, the node sums formed here (race-free by colour).
-  const int n_c = options_.fitted_point_values ? n_basis : 1;
-  const auto n_nodes = static_cast<std::int32_t>(alpha_.size());
-  transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
-  transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    for (int c = 0; c < n_basis; ++c) {
-      transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
-      transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
-    }
-  });
-  for_each_region_coloured([&](std::int32_t r) {
-    const Corners& corner = corners_[r];
-    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
-    for (int k = 0; k < (1 << D); ++k) L += v_new[corner.node[k]] * corner.G[k].transpose();
-    double sum = 0.0;
-    const unsigned used = value_corners(corner, sum);
-    const double scale = regions_[r].volume / sum;
-    // The point in its cell, in cells from the lower corner (as build_regions places it).
-    const Vec<D> lo = grid.origin() + cell_index(regions_[r].cell).template cast<double>().cwiseProduct(h_);
-    const Vec<D> local = (regions_[r].centroid - lo).cwiseProduct(h_.cwiseInverse());
-    for (int k = 0; k < (1 << D); ++k) {
-      if (!(used >> k & 1U)) continue;
-      const std::size_t at = static_cast<std::size_t>(corner.node[k]) * n_basis;
-      const double w = scale * corner.S[k];
-      for (int c = 0; c < n_c; ++c) {
-        const double beta = c == 0 ? 1.0 : local[c - 1] - ((k >> (c - 1)) & 1);
-        transpose_sum_[at + c] += (w * beta) * L;
-        transpose_weight_[at + c] += w * beta;
-      }
-    }
-  });
-}
-
-template <int D>
-Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p, double& weight) const {
-  // psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over the particle's wide stencil.
-  const int n_c = options_.fitted_point_values ? n_basis : 1;
-  const std::size_t q = p * D * 3;
-  const std::int32_t* axis_node = &cache_.axis_node[q];
-  const double* axis_W = &wide_[q];
-  const double* axis_r = &offset_[q];
-  Eigen::Matrix<double, D, D> G = Eigen::Matrix<double, D, D>::Zero();
-  weight = 0.0;
-  for_each_slot<D>([&](const std::array<int, D>& k) {
-    double W;
-    const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
-    if (W <= 0.0) return;
-    const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];
-    const std::size_t at = static_cast<std::size_t>(i) * n_basis;
-    for (int c = 0; c < n_c; ++c) {
-      double psi = rows[c * n_basis];
-      for (int a = 0; a < D; ++a) psi += rows[c * n_basis + 1 + a] * axis_r[3 * a + k[a]];
-      psi *= W;
-      G += psi * transpose_sum_[at + c];
-      weight += psi * transpose_weight_[at + c];
-    }
-  });
-  return G;
 }
 
 template <int D>

@@ -281,7 +281,22 @@ class Integrator {
   /// fn(region index) for every integration region, one colour of cells after the other: the
   /// regions of one colour's cells share no corner node, so fn may add to its corners' nodes.
   template <class Fn>
-  void for_each_region_coloured(Fn&& fn) const;
+  void for_each_region_coloured(Fn&& fn) const {
+    for (const std::vector<std::int32_t>& cells : colour_cells_) {
+      const auto n = static_cast<std::int64_t>(cells.size());
+#pragma omp parallel for schedule(static)
+      for (std::int64_t k = 0; k < n; ++k) {
+        const std::int32_t c = cells[static_cast<std::size_t>(k)];
+        for (std::int32_t r = cell_begin_[c]; r < cell_begin_[c + 1]; ++r) fn(r);
+      }
+    }
+  }
+  /// The grid velocity gradient at region r's point, sum_k v_k (x) G_kq over its cell's corners.
+  [[nodiscard]] Eigen::Matrix<double, D, D> point_gradient(std::int32_t r, const std::vector<Vec<D>>& v) const {
+    Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    for (int k = 0; k < (1 << D); ++k) L += v[corners_[r].node[k]] * corners_[r].G[k].transpose();
+    return L;
+  }
   void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
   /// transposed_gradient_sum's node sums: per node k and fit coefficient c,
   /// sum_q (V_q / s_q) S_kq beta_c(x_q - x_k) L_q over the points whose value reads node k's fit.

@@ -1,0 +1,120 @@
+// The WLS particles' velocity gradients other than Eq. 29 (docs/wls.md, departures 4 and 17):
+// the node sums of the quadrature gradient and of the transposed gradient over the integration
+// regions, and the transposed gradient's gather over a particle's wide stencil.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "cairn/transfer/transfer.hpp"
+#include "cairn/wls/grid_stencil.hpp"
+#include "cairn/wls/integrator.hpp"
+
+namespace cairn::wls {
+
+using detail::for_each_slot;
+using detail::stencil_entry;
+
+template <int D>
+void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
+  // (the strain rate the internal force of Eq. 24 is the power conjugate of), and its S V-weighted
+  // mean over the integration points around each node, scattered to the corners.
+  const std::int32_t n_nodes = grid.n_nodes();
+  node_gradient_.resize(n_nodes);
+  node_gradient_weight_.resize(n_nodes);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    node_gradient_[i].setZero();
+    node_gradient_weight_[i] = 0.0;
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Corners& corner = corners_[r];
+    const Eigen::Matrix<double, D, D> L = point_gradient(r, v_new);
+    for (int k = 0; k < (1 << D); ++k) {
+      const double w = corner.S[k] * regions_[r].volume;
+      node_gradient_[corner.node[k]] += w * L;
+      node_gradient_weight_[corner.node[k]] += w;
+    }
+  });
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    if (node_gradient_weight_[i] > 0.0) node_gradient_[i] /= node_gradient_weight_[i];
+  });
+}
+
+template <int D>
+void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
+  // sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k) with
+  // beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc = sum_p psi_kcp
+  // sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc with
+  // A_kc = sum_q (V_q / s_q) S_kq beta_c L_q, the node sums formed here (race-free by colour).
+  const int n_c = options_.fitted_point_values ? n_basis : 1;
+  const auto n_nodes = static_cast<std::int32_t>(alpha_.size());
+  transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+  transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    for (int c = 0; c < n_basis; ++c) {
+      transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
+      transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
+    }
+  });
+  for_each_region_coloured([&](std::int32_t r) {
+    const Corners& corner = corners_[r];
+    const Eigen::Matrix<double, D, D> L = point_gradient(r, v_new);
+    double sum = 0.0;
+    const unsigned used = value_corners(corner, sum);
+    const double scale = regions_[r].volume / sum;
+    // The point in its cell, in cells from the lower corner (as build_regions places it).
+    const Vec<D> lo = grid.origin() + cell_index(regions_[r].cell).template cast<double>().cwiseProduct(h_);
+    const Vec<D> local = (regions_[r].centroid - lo).cwiseProduct(h_.cwiseInverse());
+    for (int k = 0; k < (1 << D); ++k) {
+      if (!(used >> k & 1U)) continue;
+      const std::size_t at = static_cast<std::size_t>(corner.node[k]) * n_basis;
+      const double w = scale * corner.S[k];
+      for (int c = 0; c < n_c; ++c) {
+        const double beta = c == 0 ? 1.0 : local[c - 1] - ((k >> (c - 1)) & 1);
+        transpose_sum_[at + c] += (w * beta) * L;
+        transpose_weight_[at + c] += w * beta;
+      }
+    }
+  });
+}
+
+template <int D>
+Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p, double& weight) const {
+  // psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over the particle's wide stencil.
+  const int n_c = options_.fitted_point_values ? n_basis : 1;
+  const std::size_t q = p * D * 3;
+  const std::int32_t* axis_node = &cache_.axis_node[q];
+  const double* axis_W = &wide_[q];
+  const double* axis_r = &offset_[q];
+  Eigen::Matrix<double, D, D> G = Eigen::Matrix<double, D, D>::Zero();
+  weight = 0.0;
+  for_each_slot<D>([&](const std::array<int, D>& k) {
+    double W;
+    const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
+    if (W <= 0.0) return;
+    const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];
+    const std::size_t at = static_cast<std::size_t>(i) * n_basis;
+    for (int c = 0; c < n_c; ++c) {
+      double psi = rows[c * n_basis];
+      for (int a = 0; a < D; ++a) psi += rows[c * n_basis + 1 + a] * axis_r[3 * a + k[a]];
+      psi *= W;
+      G += psi * transpose_sum_[at + c];
+      weight += psi * transpose_weight_[at + c];
+    }
+  });
+  return G;
+}
+
+template void Integrator<1>::quadrature_gradients(const Grid<1>&, const std::vector<Vec<1>>&);
+template void Integrator<2>::quadrature_gradients(const Grid<2>&, const std::vector<Vec<2>>&);
+template void Integrator<3>::quadrature_gradients(const Grid<3>&, const std::vector<Vec<3>>&);
+template void Integrator<1>::transpose_gradients(const Grid<1>&, const std::vector<Vec<1>>&);
+template void Integrator<2>::transpose_gradients(const Grid<2>&, const std::vector<Vec<2>>&);
+template void Integrator<3>::transpose_gradients(const Grid<3>&, const std::vector<Vec<3>>&);
+template Eigen::Matrix<double, 1, 1> Integrator<1>::transposed_gradient_sum(std::size_t, double&) const;
+template Eigen::Matrix<double, 2, 2> Integrator<2>::transposed_gradient_sum(std::size_t, double&) const;
+template Eigen::Matrix<double, 3, 3> Integrator<3>::transposed_gradient_sum(std::size_t, double&) const;
+
+}  // namespace cairn::wls
