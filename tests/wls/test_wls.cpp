@@ -565,39 +565,72 @@ TEST(WlsIntegration, RigidTranslationStaysUndeformed) {
   }
 }
 
+/// One step (dt = 1e-9, no stress) of a WLS disk (h = 0.05) moving with a linear velocity field,
+/// plus, by `field`: nothing ("linear"), a smooth wave six cells long in v_x ("wave"), particle-
+/// scale noise ("noise"), or instead a translation ("translation"); the RMS deviation of the
+/// particles' velocities from the field without the noise, over the particles at least 2.5 h
+/// inside, with particle_velocity = `update` and method.order = `order`.
+double one_step_velocity_error(const std::string& update, int order, const std::string& field) {
+  const double h = 0.05;
+  Config c = wls_config(2, "circle", h);
+  c.method.plugin.set("particle_velocity", update);
+  c.method.order = order;
+  std::array<std::string, 2> v = {"0.1 + 0.3 * (X - 0.5) - 0.7 * (Y - 0.5)", "-0.2 + 0.5 * (X - 0.5) + 0.1 * (Y - 0.5)"};
+  if (field == "translation") v = {"0.1", "-0.2"};
+  if (field == "wave") v[0] += " + 0.05 * sin(20 * X) * cos(20 * Y)";
+  if (field == "noise")
+    for (std::string& e : v) e += " + 0.01 * sin(1000 * X + 700 * Y)";
+  c.bodies[0].velocity = {v[0], v[1]};
+  Simulation<2> sim(c);
+  sim.step(1e-9);
+  const auto& P = sim.particles();
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t p = 0; p < P.n(); ++p) {
+    const Vec<2> x = P.reference_position[p], r = x - Vec<2>::Constant(0.5);
+    if (r.norm() > 0.3 - 2.5 * h) continue;
+    Vec<2> exact(0.1 + 0.3 * r.x() - 0.7 * r.y(), -0.2 + 0.5 * r.x() + 0.1 * r.y());
+    if (field == "translation") exact = Vec<2>(0.1, -0.2);
+    if (field == "wave") exact.x() += 0.05 * std::sin(20 * x.x()) * std::cos(20 * x.y());
+    sum += (P.velocity[p] - exact).squaredNorm();
+    ++n;
+  }
+  EXPECT_GT(n, 50);
+  return std::sqrt(sum / n);
+}
+
 // Departure 11 (docs/wls.md): with particle_velocity = "pic" a particle takes the interpolated
 // grid velocity, V_p = sum S v+ (seed 002 Eq. 1.66), instead of Eq. 27's increment. One step of
 // an unstressed disk moving with a linear field: PIC keeps the linear field exactly (node fits
 // and S reproduce it); with particle-scale noise added, FLIP keeps the noise on the particles and
 // PIC keeps only what the node fits see of it.
 TEST(WlsIntegration, PicParticleVelocityDropsTheNoiseTheGridDoesNotCarry) {
-  const double h = 0.05;
-  auto rms_deviation = [&](const std::string& update, bool noise) {
-    Config c = wls_config(2, "circle", h);
-    c.method.plugin.set("particle_velocity", update);
-    const std::string wiggle = noise ? " + 0.01 * sin(1000 * X + 700 * Y)" : "";
-    c.bodies[0].velocity = {"0.1 + 0.3 * (X - 0.5) - 0.7 * (Y - 0.5)" + wiggle,
-                            "-0.2 + 0.5 * (X - 0.5) + 0.1 * (Y - 0.5)" + wiggle};
-    Simulation<2> sim(c);
-    sim.step(1e-9);
-    const auto& P = sim.particles();
-    double sum = 0.0;
-    int n = 0;
-    for (std::size_t p = 0; p < P.n(); ++p) {
-      const Vec<2> r = P.position[p] - Vec<2>::Constant(0.5);
-      if (r.norm() > 0.3 - 2.5 * h) continue;
-      const Vec<2> exact(0.1 + 0.3 * r.x() - 0.7 * r.y(), -0.2 + 0.5 * r.x() + 0.1 * r.y());
-      sum += (P.velocity[p] - exact).squaredNorm();
-      ++n;
-    }
-    EXPECT_GT(n, 50);
-    return std::sqrt(sum / n);
-  };
-  EXPECT_LT(rms_deviation("pic", false), 1e-9);
-  const double flip = rms_deviation("flip", true), pic = rms_deviation("pic", true);
+  EXPECT_LT(one_step_velocity_error("pic", 1, "linear"), 1e-9);
+  const double flip = one_step_velocity_error("flip", 1, "noise"), pic = one_step_velocity_error("pic", 1, "noise");
   std::printf("particle velocity noise after one step: FLIP %.3e, PIC %.3e (added: 1.0e-02)\n", flip, pic);
   EXPECT_GT(flip, 0.5e-2);
   EXPECT_LT(pic, 0.5 * flip);
+}
+
+// Departure 18 (docs/wls.md): particle_velocity = "xpic" with method.order = k starts Eq. 27's
+// increment from sum S u_k, u_(j+1) = v + u_j - F(S u_j) (seed 000's XPIC(k) with the node fit F
+// for the lumped mass). One step of an unstressed disk: a translation stays exact; a linear field
+// changes only by what the reduced fits at the surface feed in; a smooth wave about six cells
+// long, which PIC's S F smears, comes back closer with each term; particle-scale noise, which FLIP
+// keeps, stays mostly out.
+TEST(WlsIntegration, XpicRestoresWhatPicSmearsAndDropsTheNoise) {
+  EXPECT_LT(one_step_velocity_error("xpic", 4, "translation"), 1e-14);
+  EXPECT_LT(one_step_velocity_error("xpic", 4, "linear"), 1e-5);  // measured 4.4e-7
+  const double one = one_step_velocity_error("xpic", 1, "wave"), two = one_step_velocity_error("xpic", 2, "wave");
+  const double four = one_step_velocity_error("xpic", 4, "wave");
+  const double flip = one_step_velocity_error("flip", 1, "noise"), noise = one_step_velocity_error("xpic", 4, "noise");
+  std::printf("XPIC(k): smooth wave (amplitude 5e-2) after one step, k = 1 (PIC) %.3e, 2 %.3e, 4 %.3e; "
+              "particle-scale noise (1e-2), k = 4 %.3e (FLIP %.3e)\n",
+              one, two, four, noise, flip);
+  EXPECT_EQ(one, one_step_velocity_error("pic", 1, "wave"));  // one term is PIC
+  EXPECT_LT(two, 0.5 * one);
+  EXPECT_LT(four, 0.5 * two);
+  EXPECT_LT(noise, 0.5 * flip);
 }
 
 // A constant body force (gravity) is fitted per particle, f_p = rho_p b (seed 001 Sec. 4.1): the

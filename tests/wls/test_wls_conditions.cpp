@@ -497,11 +497,16 @@ TEST(WlsConditions, BodyAcrossAPeriodicSeamMatchesTheShiftedBody) {
 TEST(WlsConditions, OddPeriodicAxisIsBitIdenticalForAnyThreadCount) {
   // 21 cells along the periodic x axis: the region scatters give the last cell, whose upper nodes
   // are cell 0's lower ones, a colour of its own (Integrator constructor). A body across the seam,
-  // in 1, 2 and 3 threads; with the default gradient and the transposed one (its node sums are
-  // region scatters too).
+  // in 1, 2 and 3 threads; with the default gradient and update, and with verification/plate_hole's
+  // transposed gradient (its node sums are region scatters too) and XPIC(4) particle velocities
+  // (a particle scatter per term).
   for (const std::string gradient : {"quadrature", "transpose"}) {
     Config c = periodic_config(2, 0.0);
     c.method.plugin.set("velocity_gradient", gradient);
+    if (gradient == "transpose") {
+      c.method.plugin.set("particle_velocity", std::string("xpic"));
+      c.method.order = 4;
+    }
     c.grid.extent[0] = 1.05;
     c.bodies.resize(2, c.bodies[0]);
     c.bodies[0].shape.min[0] = 0.8;

@@ -156,7 +156,8 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                 .by_default("\"flip\"")
                 .choices(update_scheme_names));
   k.push_back(Key("method", "order", T::integer,
-                 "Order k of FMPM(k) and XPIC(k); unused by other updates.")
+                 "Order k of FMPM(k) and XPIC(k), and of WLS's particle_velocity = \"xpic\"; unused "
+                 "by other updates.")
                 .by_default("1")
                 .min(1)
                 .max(64));
@@ -199,7 +200,8 @@ void declare_model_keys(std::vector<KeyDecl>& k) {
                  "Where the weak form is integrated: mpm = at the particles (every shape family and "
                  "update above); wls = the weighted-least-squares PIC method of seed 001 (node "
                  "fits, cut grid cells with one centroid point per region, central differences; "
-                 "shape, update, order and stress_update are then unused; docs/wls.md).")
+                 "shape, update and stress_update are then unused, order too unless WLS's "
+                 "particle_velocity is \"xpic\"; docs/wls.md).")
                 .by_default("\"mpm\"")
                 .choices([] { return std::vector<std::string>{"mpm", "wls"}; }));
 

@@ -536,6 +536,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const bool pic = options_.pic_velocity;
   const bool all_nodes = options_.massless_corners_included;
   const bool fitted_surface = options_.fitted_surface_velocity;
+  const bool projected = options_.xpic_order > 0;  // XPIC: start from sum S u_k
   if (held && held->empty()) held = nullptr;
   if (from_quadrature) quadrature_gradients(grid, v_new);
   if (transpose) transpose_gradients(grid, v_new);
@@ -617,10 +618,12 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
       if (w > V / transpose_band && w < V * transpose_band) L = G / w;
     }
-    // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11). A
+    // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11). With
+    // XPIC the increment starts from the particle's projected velocity (departure 18), and a
     // surface particle may start from the fitted velocity at its position instead of its own.
     const double before = particles.velocity[p].squaredNorm();
-    const Vec<D> start = fitted_surface && is_surface(particles, static_cast<std::size_t>(p))
+    const Vec<D> start = projected ? xpic_particle_[static_cast<std::size_t>(p)]
+                         : fitted_surface && is_surface(particles, static_cast<std::size_t>(p))
                              ? fitted_velocity(grid, axis_node, axis_S, particles.position[p], particles.velocity[p])
                              : particles.velocity[p];
     particles.velocity[p] = pic ? vx : Vec<D>(start + dv);

@@ -93,6 +93,10 @@ struct Options {
   /// Particle velocity update: false = Eq. 27 as printed, V_p += sum S_ip (v+_i - v_i) (FLIP);
   /// true = V_p = sum S_ip v+_i (PIC, seed 002 Eq. 1.66 without damping; docs/wls.md).
   bool pic_velocity = false;
+  /// particle_velocity = "xpic" (docs/wls.md, departure 18): the number of terms k of the XPIC(k)
+  /// projection from which Eq. 27's FLIP increment starts, sum S u_k with u_k the k-term series
+  /// of the fitted velocity (wls/xpic.cpp); 0 = off, 1 = PIC.
+  int xpic_order = 0;
   /// Velocity of the surface particles (zero mass) before Eq. 27's increment: false = their own
   /// (as printed); true = the S-weighted planar velocity fits (Eq. 10) of the well-conditioned
   /// corners of their cell at their position, so that a massless point keeps no velocity of its
@@ -193,6 +197,12 @@ class Integrator {
   /// Storage for the components the velocity conditions set per node (bit a: component a), which
   /// the engine fills each step for move_particles (wls/step.cpp).
   [[nodiscard]] std::vector<std::uint8_t>& held_components() { return held_; }
+
+  /// Options::xpic_order = k: the particles' XPIC(k) velocities sum S u_k for the next
+  /// move_particles, u_(j+1) = v + u_j - F(S u_j) from u_1 = v (the node velocities, the fits of
+  /// this step's collect) at the nodes inside the body (seed 000 Sec. 2.2 with the fit F of
+  /// Eq. 7-11 for m^-1 S^T M; wls/xpic.cpp).
+  void xpic_projection(const Grid<D>& grid, const std::vector<double>& mass, const std::vector<Vec<D>>& v);
 
   /// v+ = v + (planar W m-weighted fit of v+ - v over each node and its neighbours with mass),
   /// method.filter_acceleration (docs/wls.md); the caller imposes the velocity conditions again.
@@ -384,6 +394,11 @@ class Integrator {
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
   std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)
   std::vector<Vec<D>> filtered_;                              ///< scratch of filter_acceleration
+  /// out_p = sum S_ip u_i over the corners of particle p's cell (Eq. 5).
+  void interpolate(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& out) const;
+  std::vector<Vec<D>> xpic_node_;      ///< u_j (xpic_projection)
+  std::vector<Vec<D>> xpic_fit_;       ///< F(S u_j)
+  std::vector<Vec<D>> xpic_particle_;  ///< S u_j; after xpic_projection the particles' S u_k
 };
 
 /// The integration regions as points for a snapshot (ParaView): position = centroid, volume0 =

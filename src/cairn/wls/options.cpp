@@ -19,7 +19,9 @@ Options options(const MethodConfig& method) {
   o.transpose_gradient = method.plugin.text("velocity_gradient") == "transpose";
   o.filter_acceleration = method.plugin.boolean("filter_acceleration");
   o.hourglass_damping = method.plugin.real("hourglass_damping");
-  o.pic_velocity = method.plugin.text("particle_velocity") == "pic";
+  const std::string velocity = method.plugin.text("particle_velocity");
+  o.pic_velocity = velocity == "pic";
+  if (velocity == "xpic") o.xpic_order = method.order;
   o.fitted_surface_velocity = method.plugin.text("surface_velocity") == "fit";
   o.massless_corners_included = method.plugin.text("empty_corners") == "zero";
   o.every_symmetry_face_mirrors = method.plugin.text("mirror_planes") == "all";
@@ -99,9 +101,12 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "WLS particle velocity update: flip = V_p += sum S_ip (v+_i - v_i) (seed 001 Eq. 27 "
       "as printed); pic = V_p = sum S_ip v+_i (seed 002 Eq. 1.66), which keeps the "
       "particles' velocity noise that the node fits cannot see out of the next fits "
-      "(docs/wls.md).")
+      "(docs/wls.md); xpic = Eq. 27's increment started from the XPIC(k) projection "
+      "sum S_ip u_i instead of V_p (k = method.order; seed 000's XPIC(k) with the "
+      "least-squares fit F for the lumped mass: u_1 = v, u_(j+1) = v + u_j - F(S u_j)), which "
+      "removes that noise with little of PIC's dissipation (docs/wls.md).")
       .by_default("\"flip\"")
-      .choices([] { return std::vector<std::string>{"flip", "pic"}; }),
+      .choices([] { return std::vector<std::string>{"flip", "pic", "xpic"}; }),
     Key("", "surface_velocity", KeyType::string,
       "WLS velocity of the surface particles (zero mass) before the increment of Eq. 27: "
       "own = the particle's own velocity (as printed); fit = the planar velocity fits of the "

@@ -22,6 +22,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
     wls.damp_hourglass(grid, nodes);
     engine.impose_end_conditions();
   }
+  if (wls.options().xpic_order > 0)  // particle_velocity = "xpic": the particles' start
+    wls.xpic_projection(grid, nodes.mass, nodes.velocity);
   engine.lap(2);
   // Eq. 27-29 (or the quadrature gradient)
   engine.held_components(wls.held_components());
