@@ -191,12 +191,11 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     const bool surface = is_surface(particles, static_cast<std::size_t>(p));
     const double flag = surface ? 1.0 : 2.0;
     const Vec<D>& x_p = particles.position[p];
-    // The flags and surface positions over the 2^D corners where S can be nonzero ...
-    for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) __attribute__((always_inline)) {
+    // The surface positions over the 2^D corners where S can be nonzero ...
+    if (surface) for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) __attribute__((always_inline)) {
       double S;
       const std::int32_t i = stencil_entry<D, 6>(k, axis_node, axis_S, S);
-      sums_[i].beta += S * flag;
-      if (surface && S != 0.0) {
+      if (S != 0.0) {
         // Along a periodic axis the particle's image next to the node (x_i + r h), so that
         // x_surf of a node on the seam averages the particles on both sides of it.
         Vec<D> x = x_p;
@@ -221,10 +220,12 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
         factor[a][k][2] = w * r * r;
       }
     for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
-      double W;
+      double W, S;
       const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
-      if (W <= 0.0) return;
+      stencil_entry<D, 6>(k, axis_node, axis_S, S);  // the narrow S on the same entries, zero off the cell's corners
       NodeSums& sum = sums_[i];
+      sum.beta += S * flag;  // Eq. 13 (S > 0 implies W > 0)
+      if (W <= 0.0) return;
       auto& M = sum.moment;
       for (int r = 0; r < n_basis; ++r)
         for (int c = r; c < n_basis; ++c) {

@@ -25,11 +25,13 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
     auto cut = [&](std::int64_t c, std::array<std::int32_t, (1 << D)>& node, Vec<D>& lo,
                    std::array<CellRegion<D>, max_regions<D>>& out) {
       const IVec<D> cell = cell_index(static_cast<std::int32_t>(c));
+      std::array<std::array<std::int32_t, 2>, D> axis;  // each axis's part of the corners' storage index
+      for (int a = 0; a < D; ++a)
+        for (int side = 0; side < 2; ++side) axis[a][side] = grid.axis_index(a, cell[a] + side);
       std::array<double, (1 << D)> d;
       for (int k = 0; k < (1 << D); ++k) {
-        IVec<D> j = cell;
-        for (int a = 0; a < D; ++a) j[a] += (k >> a) & 1;
-        node[k] = grid.node_index(j);
+        node[k] = 0;
+        for (int a = 0; a < D; ++a) node[k] += axis[a][(k >> a) & 1];
         d[k] = distance_[node[k]];
       }
       lo = grid.origin() + cell.template cast<double>().cwiseProduct(h_);
