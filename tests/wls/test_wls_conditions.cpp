@@ -79,9 +79,11 @@ struct HeldBar {
 /// `transits` wave transits L / c and then held for eight more; the particles with X < 0.3
 /// sampled over the last four transits (one period of the bar's fundamental mode).
 template <int D>
-HeldBar held_bar(double L, double lo, double hi, double transits, double h = 0.05) {
+HeldBar held_bar(double L, double lo, double hi, double transits, double h = 0.05,
+                 const std::vector<std::pair<std::string, std::string>>& keys = {}) {
   constexpr double T = 1.0e3;
   Config c = bar_config(D, L, true, h);
+  for (const auto& [key, value] : keys) c.method.plugin.set(key, value);
   for (int a = 1; a < D; ++a) {
     c.bodies[0].shape.min[a] = lo;
     c.bodies[0].shape.max[a] = hi;
@@ -143,6 +145,24 @@ TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStress) {
     EXPECT_NEAR(r.mean, 1.0, 0.02) << at.L << " " << at.lo;
     EXPECT_LT(r.oscillation, 0.01) << at.L << " " << at.lo;  // (the ramp leaves the continuum at rest)
   }
+}
+
+TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStressWithTheTransposedGradient) {
+  // The set-up docs/wls.md recommends (fitted point values, transposed gradient: items 7 and 17)
+  // under a traction: the loaded face inside a cell and on a node line, in 2D and 3D. Measured
+  // 2026-11-30: mean sigma_xx / T 1.0000 and 1.0005 in 2D (particle scatter 0.10 and 0.04
+  // against 0.19 and 0.15 with the defaults); 3D as with the defaults.
+  const std::vector<std::pair<std::string, std::string>> keys = {{"velocity_gradient", "transpose"},
+                                                                  {"point_values", "fit"}};
+  for (const auto& [L, lo, hi] : {std::array<double, 3>{0.425, 0.275, 0.525}, std::array<double, 3>{0.425, 0.25, 0.55},
+                                  std::array<double, 3>{0.45, 0.275, 0.525}}) {
+    const HeldBar r = held_bar<2>(L, lo, hi, 10.0, 0.05, keys);
+    EXPECT_NEAR(r.mean, 1.0, 0.02) << L << " " << lo;
+    EXPECT_LT(r.oscillation, 0.01) << L << " " << lo;
+  }
+  const HeldBar r = held_bar<3>(0.45, 0.25, 0.55, 10.0, 0.05, keys);
+  EXPECT_NEAR(r.mean * r.section, 1.0, 0.02);
+  EXPECT_LT(r.oscillation, 0.02);
 }
 
 TEST(WlsConditions, TractionPullsAHeldBarToTheStaticStress3D) {
@@ -241,16 +261,12 @@ TEST(WlsConditions, TractionImpulseMovesAFreeBar) {
   ASSERT_NO_FATAL_FAILURE(check_free_bar<3>(0.425, false));
 }
 
-TEST(WlsConditions, TractionNeedsTheQuadratureGradient) {
-  // Eq. 29 as printed: the held bar grows node-scale noise until det F < 0 (docs/wls.md). The
-  // loads are balanced for the quadrature gradient; the transposed one (departure 17) is refused
-  // too.
-  for (const std::string gradient : {"narrow", "transpose"}) {
-    Config c = bar_config(2, 0.425, true);
-    c.tractions.push_back(end_traction(2, 1.0e3, "1"));
-    c.method.plugin.set("velocity_gradient", gradient);
-    EXPECT_THROW(Simulation<2>{c}, std::invalid_argument) << gradient;
-  }
+TEST(WlsConditions, TractionRefusesTheNarrowGradient) {
+  // Eq. 29 as printed: the held bar grows node-scale noise until det F < 0 (docs/wls.md).
+  Config c = bar_config(2, 0.425, true);
+  c.tractions.push_back(end_traction(2, 1.0e3, "1"));
+  c.method.plugin.set("velocity_gradient", "narrow");
+  EXPECT_THROW(Simulation<2>{c}, std::invalid_argument);
 }
 
 TEST(WlsConditions, TractionOnARadialBodyIsRefused) {

@@ -256,11 +256,12 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
                                     "xyz"[a] + " axis (its stencils span 3 nodes; docs/wls.md)");
     wls::Options o = wls::options(config_.method);
     // With Eq. 29 as printed a held bar under a traction grows node-scale noise until det F < 0
-    // (docs/wls.md, "Tractions"); the loads are balanced for the quadrature gradient.
-    if (!config_.tractions.empty() && !o.quadrature_gradient)
+    // (docs/wls.md, "Tractions"); the quadrature gradient and its transpose reach the static stress.
+    if (!config_.tractions.empty() && !o.quadrature_gradient && !o.transpose_gradient)
       throw std::invalid_argument(config_.tractions.front().where.str() + ": [[traction]] under method.integration = "
-                                  "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default; "
-                                  "docs/wls.md)");
+                                  "\"wls\" needs method.velocity_gradient = \"quadrature\" (the default) or "
+                                  "\"transpose\": with \"narrow\" (Eq. 29 as printed) a loaded body grows node-scale "
+                                  "noise (docs/wls.md)");
     if (o.adjoint_point_stress && !o.quadrature_gradient)
       throw std::invalid_argument("method.point_values = \"adjoint\" needs method.velocity_gradient = "
                                   "\"quadrature\" (the default): it is that gradient's transpose (docs/wls.md)");
