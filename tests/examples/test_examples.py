@@ -196,6 +196,33 @@ def plate_with_holes(cairn, source, out):
           f"plate_with_holes: the wall stopped the plate (v_y {vy:.3f} m/s at t = {t1 * 1e3:.1f} ms, lowest y {lowest * 1e3:.2f} mm)")
 
 
+def wls_plate_hole(cairn, source, out):
+    # 2.5 mm cells (1.25 mm in the example): 4 cells across the hole's radius. The particles with
+    # volume next to the hole against Kirsch's infinite-plate field at their reference positions.
+    run(cairn, source, "wls_plate_hole_2d.toml", out, ["grid.cell_size=2.5e-3"])
+    T, a, h = 1.0e5, 0.01, 2.5e-3
+    path = sorted(glob.glob(os.path.join(out, "snapshots", "particles-*.h5")))[-1]
+    with h5py.File(path, "r") as f:
+        p = f["particles"]
+        X = p["position"][:] - p["displacement"][:]
+        s, volume = p["stress"][:] / T, p["volume"][:]  # stress: xx yy zz xy yz xz
+    r, th = np.hypot(X[:, 0], X[:, 1]), np.arctan2(X[:, 1], X[:, 0])
+    q, c2 = a * a / (r * r), np.cos(2 * th)
+    srr = 0.5 * (1 - q) + 0.5 * (1 - 4 * q + 3 * q * q) * c2
+    stt = 0.5 * (1 + q) - 0.5 * (1 + 3 * q * q) * c2
+    srt = -0.5 * (1 + 2 * q - 3 * q * q) * np.sin(2 * th)
+    c, sn = np.cos(th), np.sin(th)
+    kirsch_xx = srr * c * c + stt * sn * sn - 2 * srt * sn * c
+    far = X[:, 0] > 0.06
+    check(abs(s[far, 0].mean() - 1.0) < 0.02, f"wls_plate_hole: far field sigma_xx {s[far, 0].mean():.3f} T (the traction T)")
+    near = (r < a + 0.35 * h) & (volume > 0)
+    top, side = near & (th > math.radians(80)), near & (th < math.radians(10))
+    check(top.any() and abs(s[top, 0].mean() / kirsch_xx[top].mean() - 1) < 0.15,
+          f"wls_plate_hole: at the hole's top sigma_xx {s[top, 0].mean():.3f} T, Kirsch {kirsch_xx[top].mean():.3f} T")
+    check(side.any() and s[side, 1].mean() < -0.3,
+          f"wls_plate_hole: at the hole's side sigma_yy {s[side, 1].mean():.3f} T (compressed; Kirsch -1 T at the hole)")
+
+
 def tutorial(cairn, source, out):
     """docs/tutorial.md builds examples/disk_wall.toml block by block: its TOML blocks put
     together must resolve to the same input (the output folder aside)."""
@@ -224,7 +251,8 @@ def main():
     cairn, source = sys.argv[1], sys.argv[2]
     with tempfile.TemporaryDirectory(prefix="cairn_examples_") as tmp:
         try:
-            for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block, meshed_projectile, plate_with_holes):
+            for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block, meshed_projectile, plate_with_holes,
+                         wls_plate_hole):
                 print(case.__name__)
                 case(cairn, source, os.path.join(tmp, case.__name__))
         except CheckFailed as e:
