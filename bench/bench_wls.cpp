@@ -2,6 +2,8 @@
 // seed 001 Sec. 5.1 (annulus R_I = 0.5, R_O = 1, neo-Hookean Eq. 31-32, nu = 0, plane strain,
 // central differences) spun and breathing, on a grid of h = 0.02 (about 4 particles per cell):
 //   * WLS (method.integration = "wls", radial arrangement of Fig. 4b, surface particles);
+//   * WLS with the set-up docs/wls.md recommends (point_values = "fit", velocity_gradient =
+//     "transpose");
 //   * the quadratic B-spline MPM step on the same ring and grid (Cartesian 2 x 2 lattice), the
 //     reference of issue 12's "no more than 4x the quadratic B-spline step per particle".
 // Run: build/release/bench/cairn_bench --benchmark_filter=Wls
@@ -17,7 +19,10 @@
 namespace cairn {
 namespace {
 
-Config ring_config(bool wls) {
+enum class Ring { wls, wls_fit_transpose, bspline2 };
+
+Config ring_config(Ring kind) {
+  const bool wls = kind != Ring::bspline2;
   std::string text = R"(
 [simulation]
 dimension = 2
@@ -45,15 +50,18 @@ velocity = ["0.5*X - 0.3*Y", "0.5*Y + 0.3*X"]
   text += wls ? "arrangement = \"radial\"\n[method]\nshape = \"linear\"\nintegration = \"wls\"\n"
               : "arrangement = \"cartesian\"\n[method]\nshape = \"bspline2\"\n";
   text += "time_integration = \"central_difference\"\n";
+  if (kind == Ring::wls_fit_transpose) text += "point_values = \"fit\"\nvelocity_gradient = \"transpose\"\n";
   return load_config_string(text, "bench_wls.toml", {});
 }
 
-void run_ring(benchmark::State& state, bool wls) { bench::run_steps<2>(state, ring_config(wls)); }
+void run_ring(benchmark::State& state, Ring kind) { bench::run_steps<2>(state, ring_config(kind)); }
 
-void BM_WlsStep_Ring(benchmark::State& state) { run_ring(state, true); }
-void BM_WlsReference_Ring_BSpline2(benchmark::State& state) { run_ring(state, false); }
+void BM_WlsStep_Ring(benchmark::State& state) { run_ring(state, Ring::wls); }
+void BM_WlsStepFitTranspose_Ring(benchmark::State& state) { run_ring(state, Ring::wls_fit_transpose); }
+void BM_WlsReference_Ring_BSpline2(benchmark::State& state) { run_ring(state, Ring::bspline2); }
 
 BENCHMARK(BM_WlsStep_Ring)->Arg(1)->Arg(omp_get_num_procs())->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WlsStepFitTranspose_Ring)->Arg(1)->Arg(omp_get_num_procs())->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WlsReference_Ring_BSpline2)->Arg(1)->Arg(omp_get_num_procs())->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -78,32 +78,57 @@ void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<V
       }
     }
   });
+  // Folded with the node's fit rows, once per node rather than once per particle and entry:
+  // sum_c psi_kcp A_kc = W_kp sum_e b_e(x_p - x_k) B_ke with B_ke = sum_c (M_k^-1)_ce A_kc.
+  const int stride = n_coef_ * n_basis;
+  for_each_node(n_nodes, [&](std::int32_t i) {
+    const std::size_t at = static_cast<std::size_t>(i) * n_basis;
+    const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * stride];
+    std::array<Eigen::Matrix<double, D, D>, n_basis> A;
+    std::array<double, n_basis> a;
+    for (int c = 0; c < n_c; ++c) {
+      A[c] = transpose_sum_[at + c];
+      a[c] = transpose_weight_[at + c];
+    }
+    for (int e = 0; e < n_basis; ++e) {
+      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero();
+      double b = 0.0;
+      for (int c = 0; c < n_c; ++c) {
+        B += rows[c * n_basis + e] * A[c];
+        b += rows[c * n_basis + e] * a[c];
+      }
+      transpose_sum_[at + e] = B;
+      transpose_weight_[at + e] = b;
+    }
+  });
 }
 
 template <int D>
 Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p, double& weight) const {
-  // psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over the particle's wide stencil.
-  const int n_c = options_.fitted_point_values ? n_basis : 1;
+  // sum_k sum_c psi_kcp A_kc with psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over
+  // the particle's wide stencil: W_kp sum_e b_e B_ke with the node sums transpose_gradients folded.
   const std::size_t q = p * D * 3;
   const std::int32_t* axis_node = &cache_.axis_node[q];
   const double* axis_W = &wide_[q];
   const double* axis_r = &offset_[q];
   Eigen::Matrix<double, D, D> G = Eigen::Matrix<double, D, D>::Zero();
-  weight = 0.0;
-  for_each_slot<D>([&](const std::array<int, D>& k) {
+  double w = 0.0;
+  for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
     double W;
     const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
     if (W <= 0.0) return;
-    const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];
     const std::size_t at = static_cast<std::size_t>(i) * n_basis;
-    for (int c = 0; c < n_c; ++c) {
-      double psi = rows[c * n_basis];
-      for (int a = 0; a < D; ++a) psi += rows[c * n_basis + 1 + a] * axis_r[3 * a + k[a]];
-      psi *= W;
-      G += psi * transpose_sum_[at + c];
-      weight += psi * transpose_weight_[at + c];
+    Eigen::Matrix<double, D, D> B = transpose_sum_[at];
+    double b = transpose_weight_[at];
+    for (int a = 0; a < D; ++a) {
+      const double r = axis_r[3 * a + k[a]];
+      B += r * transpose_sum_[at + 1 + a];
+      b += r * transpose_weight_[at + 1 + a];
     }
+    G += W * B;
+    w += W * b;
   });
+  weight = w;
   return G;
 }
 
