@@ -494,10 +494,10 @@ void check_linear_velocity(const std::string& kind) {
     for (int b = 0; b < D; ++b) e += " + " + std::to_string(A(a, b)) + " * " + std::string(1, "XYZ"[b]);
     c.bodies[0].velocity.push_back(e);
   }
-  // The node values alone (the default), and with the slopes (point_values = "fit"), which the
-  // gradient of the fit reads: the two ways collect sums the fits.
+  // The node values alone (the default), and with the velocity's slopes (surface_velocity =
+  // "fit"), which the gradient of the fit reads: the two ways collect sums the velocity fits.
   for (const bool slopes : {false, true}) {
-    if (slopes) c.method.plugin.set("point_values", std::string("fit"));
+    if (slopes) c.method.plugin.set("surface_velocity", std::string("fit"));
     Simulation<D> sim(c);
     const auto& w = *sim.wls();
     int checked = 0;

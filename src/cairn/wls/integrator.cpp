@@ -244,8 +244,10 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   // entry adds one value per field and coefficient (the node values c0 alone unless slopes are
   // read) instead of n_basis. The fields are added in pairs (GCC/Clang vector extensions, SSE2:
   // the same operations per field) over compile-time numbers of pairs and coefficients.
+  // The velocity's slopes are read only by the extrapolated spurious and the fitted surface
+  // velocity: without them the pairs that hold velocity components alone form c0 only.
   using Pair = double __attribute__((vector_size(16), may_alias));
-  auto fits = [&]<int n_pair, int n_coef>() {
+  auto fits = [&]<int n_pair, int n_coef, int n_value_only>() {
     scatter(cache_, [&](std::int32_t p, const auto&) {
       const std::size_t q = static_cast<std::size_t>(p) * D * 3;
       const std::int32_t* axis_node = &cache_.axis_node[q];
@@ -270,17 +272,21 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
         }
         Pair* l = reinterpret_cast<Pair*>(&coef_[static_cast<std::size_t>(i) * n_coef * n_row]);
         for (int m = 0; m < n_pair; ++m)
-          for (int c = 0; c < n_coef; ++c) l[c * (n_row / 2) + m] += psi[c] * f[m];
+          for (int c = 0; c < (m < n_value_only ? 1 : n_coef); ++c) l[c * (n_row / 2) + m] += psi[c] * f[m];
       });
     });
   };
   constexpr int all_pairs = (n_fields + 1) / 2, no_body_pairs = (n_fields - D + 1) / 2;
+  constexpr int velocity_pairs = D / 2;  // the pairs of velocity components alone
   if (n_coef_ == 1) {
-    if (body_force) fits.template operator()<all_pairs, 1>();
-    else fits.template operator()<no_body_pairs, 1>();
+    if (body_force) fits.template operator()<all_pairs, 1, 0>();
+    else fits.template operator()<no_body_pairs, 1, 0>();
+  } else if (options_.extrapolated_spurious_velocity || options_.fitted_surface_velocity) {
+    if (body_force) fits.template operator()<all_pairs, n_basis, 0>();
+    else fits.template operator()<no_body_pairs, n_basis, 0>();
   } else {
-    if (body_force) fits.template operator()<all_pairs, n_basis>();
-    else fits.template operator()<no_body_pairs, n_basis>();
+    if (body_force) fits.template operator()<all_pairs, n_basis, velocity_pairs>();
+    else fits.template operator()<no_body_pairs, n_basis, velocity_pairs>();
   }
   for_each_node(n_nodes, [&](std::int32_t i) {  // the node values c0 (Eq. 11)
     if (count_[i] == 0) return;

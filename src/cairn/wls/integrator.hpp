@@ -226,8 +226,8 @@ class Integrator {
   /// beta_i of Eq. 13 (with the mirror images across symmetry planes).
   [[nodiscard]] double node_flag(std::int32_t i) const { return sums_[i].beta; }
   /// Gradient (Eq. 12) of the velocity fit of node i from the last collect; zero where reduced,
-  /// and zero unless the options read the fits' slopes (fitted_point_values or
-  /// extrapolated_spurious_velocity: otherwise only the node values are fitted).
+  /// and zero unless the options read the velocity fit's slopes (extrapolated_spurious_velocity
+  /// or fitted_surface_velocity; fitted_point_values alone reads the other fields' slopes).
   [[nodiscard]] Eigen::Matrix<double, D, D> velocity_gradient_fit(std::int32_t i) const;
   /// Moment matrix M of node i (Eq. 9, r in cells) from the last collect.
   [[nodiscard]] Eigen::Matrix<double, D + 1, D + 1> moment_matrix(std::int32_t i) const;
