@@ -1,6 +1,6 @@
 // The WLS particles' velocity gradients other than Eq. 29 (docs/wls.md, departures 4 and 17):
 // the node sums of the quadrature gradient and of the transposed gradient over the integration
-// regions, and the transposed gradient's gather over a particle's wide stencil.
+// regions (one pass), and the transposed gradient's gather over a particle's wide stencil.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -16,17 +16,37 @@ using detail::for_each_slot;
 using detail::stencil_entry;
 
 template <int D>
-void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
-  // The velocity gradient at every integration point, sum_k v_k (x) G_kq over its cell's corners
-  // (the strain rate the internal force of Eq. 24 is the power conjugate of), and its S V-weighted
-  // mean over the integration points around each node, scattered to the corners.
+void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
+  // The velocity gradient at every integration point, L_q = sum_k v_k (x) G_kq over its cell's
+  // corners (the strain rate the internal force of Eq. 24 is the power conjugate of), and in one
+  // pass over the regions:
+  //  - its S V-weighted mean over the integration points around each node (the quadrature
+  //    gradient), scattered to the corners;
+  //  - with the transposed gradient, Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
+  //    sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k)
+  //    with beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc =
+  //    sum_p psi_kcp sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc
+  //    with A_kc = sum_q (V_q / s_q) S_kq beta_c L_q, the node sums formed here (race-free by
+  //    colour).
+  const bool transpose = options_.transpose_gradient;
+  const int n_c = options_.fitted_point_values ? n_basis : 1;
   const std::int32_t n_nodes = grid.n_nodes();
   node_gradient_.resize(n_nodes);
   node_gradient_weight_.resize(n_nodes);
+  if (transpose) {
+    transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+    transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
+  }
   for_each_node(n_nodes, [&](std::int32_t i) {
     node_gradient_[i].setZero();
     node_gradient_weight_[i] = 0.0;
+    if (transpose)
+      for (int c = 0; c < n_basis; ++c) {
+        transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
+        transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
+      }
   });
+  const Vec<D> inv_h = h_.cwiseInverse();
   for_each_region_coloured([&](std::int32_t r) {
     const Corners& corner = corners_[r];
     const Eigen::Matrix<double, D, D> L = point_gradient(r, v_new);
@@ -35,38 +55,13 @@ void Integrator<D>::quadrature_gradients(const Grid<D>& grid, const std::vector<
       node_gradient_[corner.node[k]] += w * L;
       node_gradient_weight_[corner.node[k]] += w;
     }
-  });
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    if (node_gradient_weight_[i] > 0.0) node_gradient_[i] /= node_gradient_weight_[i];
-  });
-}
-
-template <int D>
-void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new) {
-  // Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
-  // sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k) with
-  // beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc = sum_p psi_kcp
-  // sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc with
-  // A_kc = sum_q (V_q / s_q) S_kq beta_c L_q, the node sums formed here (race-free by colour).
-  const int n_c = options_.fitted_point_values ? n_basis : 1;
-  const auto n_nodes = static_cast<std::int32_t>(alpha_.size());
-  transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
-  transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
-  for_each_node(n_nodes, [&](std::int32_t i) {
-    for (int c = 0; c < n_basis; ++c) {
-      transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
-      transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
-    }
-  });
-  for_each_region_coloured([&](std::int32_t r) {
-    const Corners& corner = corners_[r];
-    const Eigen::Matrix<double, D, D> L = point_gradient(r, v_new);
+    if (!transpose) return;
     double sum = 0.0;
     const unsigned used = value_corners(corner, sum);
     const double scale = regions_[r].volume / sum;
     // The point in its cell, in cells from the lower corner (as build_regions places it).
     const Vec<D> lo = grid.origin() + cell_index(regions_[r].cell).template cast<double>().cwiseProduct(h_);
-    const Vec<D> local = (regions_[r].centroid - lo).cwiseProduct(h_.cwiseInverse());
+    const Vec<D> local = (regions_[r].centroid - lo).cwiseProduct(inv_h);
     for (int k = 0; k < (1 << D); ++k) {
       if (!(used >> k & 1U)) continue;
       const std::size_t at = static_cast<std::size_t>(corner.node[k]) * n_basis;
@@ -78,10 +73,13 @@ void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<V
       }
     }
   });
-  // Folded with the node's fit rows, once per node rather than once per particle and entry:
-  // sum_c psi_kcp A_kc = W_kp sum_e b_e(x_p - x_k) B_ke with B_ke = sum_c (M_k^-1)_ce A_kc.
+  // The means; and the transposed sums folded with the node's fit rows, once per node rather than
+  // once per particle and entry: sum_c psi_kcp A_kc = W_kp sum_e b_e(x_p - x_k) B_ke with
+  // B_ke = sum_c (M_k^-1)_ce A_kc (only where a particle's wide stencil reads them: count_ > 0).
   const int stride = n_coef_ * n_basis;
   for_each_node(n_nodes, [&](std::int32_t i) {
+    if (node_gradient_weight_[i] > 0.0) node_gradient_[i] /= node_gradient_weight_[i];
+    if (!transpose || count_[i] == 0) return;
     const std::size_t at = static_cast<std::size_t>(i) * n_basis;
     const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * stride];
     std::array<Eigen::Matrix<double, D, D>, n_basis> A;
@@ -106,7 +104,7 @@ void Integrator<D>::transpose_gradients(const Grid<D>& grid, const std::vector<V
 template <int D>
 Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p, double& weight) const {
   // sum_k sum_c psi_kcp A_kc with psi_kcp = W_kp (M_k^-1 b_p)_c (Eq. 10 as collect sums it), over
-  // the particle's wide stencil: W_kp sum_e b_e B_ke with the node sums transpose_gradients folded.
+  // the particle's wide stencil: W_kp sum_e b_e B_ke with the node sums gradient_sums folded.
   const std::size_t q = p * D * 3;
   const std::int32_t* axis_node = &cache_.axis_node[q];
   const double* axis_W = &wide_[q];
@@ -132,12 +130,9 @@ Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p
   return G;
 }
 
-template void Integrator<1>::quadrature_gradients(const Grid<1>&, const std::vector<Vec<1>>&);
-template void Integrator<2>::quadrature_gradients(const Grid<2>&, const std::vector<Vec<2>>&);
-template void Integrator<3>::quadrature_gradients(const Grid<3>&, const std::vector<Vec<3>>&);
-template void Integrator<1>::transpose_gradients(const Grid<1>&, const std::vector<Vec<1>>&);
-template void Integrator<2>::transpose_gradients(const Grid<2>&, const std::vector<Vec<2>>&);
-template void Integrator<3>::transpose_gradients(const Grid<3>&, const std::vector<Vec<3>>&);
+template void Integrator<1>::gradient_sums(const Grid<1>&, const std::vector<Vec<1>>&);
+template void Integrator<2>::gradient_sums(const Grid<2>&, const std::vector<Vec<2>>&);
+template void Integrator<3>::gradient_sums(const Grid<3>&, const std::vector<Vec<3>>&);
 template Eigen::Matrix<double, 1, 1> Integrator<1>::transposed_gradient_sum(std::size_t, double&) const;
 template Eigen::Matrix<double, 2, 2> Integrator<2>::transposed_gradient_sum(std::size_t, double&) const;
 template Eigen::Matrix<double, 3, 3> Integrator<3>::transposed_gradient_sum(std::size_t, double&) const;

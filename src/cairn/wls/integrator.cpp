@@ -308,7 +308,7 @@ template <int D>
 void Integrator<D>::adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles) {
   // The quadrature gradient gives particle p the velocity gradient
   //   L_p = sum_k (S_kp / s_p) sum_q S_kq V_q L_q / W_k,  W_k = sum_q S_kq V_q,
-  // s_p = sum of S_kp over the corners with W_k > 0 (quadrature_gradients, move_particles).
+  // s_p = sum of S_kp over the corners with W_k > 0 (gradient_sums, move_particles).
   // The stress power of the particles, sum_p V_p sigma_p : L_p, is then sum_q V_q sigma_q : L_q
   // exactly when sigma_q = sum_k S_kq N_k / W_k with N_k = sum_p S_kp V_p sigma_p / s_p: the
   // transpose of that transfer. With it the internal force of Eq. 24, whose power is
@@ -545,8 +545,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
   const bool fitted_surface = options_.fitted_surface_velocity;
   const bool projected = options_.xpic_order > 0;  // XPIC: start from sum S u_k
   if (held && held->empty()) held = nullptr;
-  if (from_quadrature) quadrature_gradients(grid, v_new);
-  if (transpose) transpose_gradients(grid, v_new);
+  if (from_quadrature) gradient_sums(grid, v_new);
   particle_gradient_.resize(particles.n());
   // Eq. 27-29 for particle p; returns its kinetic energy change (the energy budget's sum).
   const auto move = [&](std::int64_t p, const auto&) {

@@ -307,11 +307,11 @@ class Integrator {
     for (int k = 0; k < (1 << D); ++k) L += v[corners_[r].node[k]] * corners_[r].G[k].transpose();
     return L;
   }
-  void quadrature_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
-  /// transposed_gradient_sum's node sums: per node k and fit coefficient c,
-  /// A_kc = sum_q (V_q / s_q) S_kq beta_c(x_q - x_k) L_q over the points whose value reads node
-  /// k's fit, then folded with its fit rows: B_ke = sum_c (M_k^-1)_ce A_kc (basis function e).
-  void transpose_gradients(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
+  /// One pass over the integration regions for the particles' gradients: the quadrature
+  /// gradient's S V-weighted node means of L_q and, with transpose_gradient, transposed_gradient_sum's
+  /// node sums A_kc = sum_q (V_q / s_q) S_kq beta_c(x_q - x_k) L_q over the points whose value reads
+  /// node k's fit, folded with its fit rows: B_ke = sum_c (M_k^-1)_ce A_kc (basis function e).
+  void gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>& v_new);
   void adjoint_point_stress(const Grid<D>& grid, const Particles<D>& particles);
   /// The fitted velocity at x of a particle with stencil (axis_node, axis_S) (move_particles).
   Vec<D> fitted_velocity(const Grid<D>& grid, const std::int32_t* axis_node, const double* axis_S, const Vec<D>& x,
@@ -389,7 +389,7 @@ class Integrator {
     for (int k = 0; k < (1 << D); ++k) sum += corner.S[k];
     return (1U << (1 << D)) - 1;
   }
-  std::vector<Eigen::Matrix<double, D, D>> transpose_sum_;      ///< n_nodes x n_basis: B_ke (transpose_gradients)
+  std::vector<Eigen::Matrix<double, D, D>> transpose_sum_;      ///< n_nodes x n_basis: B_ke (gradient_sums)
   std::vector<double> transpose_weight_;                        ///< the same sums without L_q
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node

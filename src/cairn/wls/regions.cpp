@@ -65,7 +65,7 @@ void Integrator<D>::build_regions(const Grid<D>& grid) {
         q.volume = out[r].volume * thickness;
         q.centroid = out[r].centroid;
         // The corners' nodes, S and G at the point, for the stages that read them (integrate,
-        // quadrature_gradients) as for the values below.
+        // gradient_sums) as for the values below.
         const Vec<D> local = (q.centroid - lo).cwiseProduct(inv_h);
         Corners& corner = corners_[begin[c] + r];
         for (int k = 0; k < (1 << D); ++k) {
