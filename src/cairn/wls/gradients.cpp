@@ -22,7 +22,7 @@ void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>
   // pass over the regions:
   //  - its S V-weighted mean over the integration points around each node (the quadrature
   //    gradient), scattered to the corners;
-  //  - with the transposed gradient, Seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
+  //  - with the transposed gradient, seed 001 Eq. 10 and 19-21 as build_regions evaluates them:
   //    sigma_q = sum_{k used} (S_kq / s_q) fit_k(x_q), fit_k(x) = sum_c coef_kc beta_c(x - x_k)
   //    with beta = [1, r] (r in cells; only c = 0 with the node values) and coef_kc =
   //    sum_p psi_kcp sigma_p: so sum_q V_q sigma_q : L_q = sum_p sigma_p : sum_k sum_c psi_kcp A_kc
