@@ -239,13 +239,15 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     });
   });
   fit_nodes(grid);
-  // Second pass: the coefficients c = M^-1 l of every field (Eq. 10) summed directly, c_ck +=
-  // psi_c f_k with psi_c = W (M^-1 b)_c: the loads l of Eq. 9 are never formed, so each stencil
-  // entry adds one value per field and coefficient (the node values c0 alone unless slopes are
-  // read) instead of n_basis. The fields are added in pairs (GCC/Clang vector extensions, SSE2:
-  // the same operations per field) over compile-time numbers of pairs and coefficients.
+  // Second pass: the fits (Eq. 9-10). Where only a field's value c0 is read, c0 = psi_0 . f is
+  // summed directly, psi_0 = W (M^-1 b)_0: one value per field and stencil entry instead of the
+  // n_basis loads. Where the slopes are read too (fitted point values, the extrapolated spurious
+  // and the fitted surface velocity), the loads l_e = sum W b_e f of Eq. 9 are summed and made
+  // c = M^-1 l once per node: as many sums as coefficients, without forming psi per entry.
   // The velocity's slopes are read only by the extrapolated spurious and the fitted surface
-  // velocity: without them the pairs that hold velocity components alone form c0 only.
+  // velocity: without them the pairs that hold velocity components alone take c0 directly.
+  // The fields are added in pairs (GCC/Clang vector extensions, SSE2: the same operations per
+  // field) over compile-time numbers of pairs and coefficients.
   using Pair = double __attribute__((vector_size(16), may_alias));
   auto fits = [&]<int n_pair, int n_coef, int n_value_only>() {
     scatter(cache_, [&](std::int32_t p, const auto&) {
@@ -261,18 +263,23 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
         const double r0 = axis_r[k[0]];
         const double r1 = D > 1 ? axis_r[3 + k[D > 1 ? 1 : 0]] : 0.0;
         const double r2 = D > 2 ? axis_r[6 + k[D > 2 ? 2 : 0]] : 0.0;
-        const double* inverse = &inverse_rows_[static_cast<std::size_t>(i) * n_coef * n_basis];
-        Pair psi[n_coef];
-        for (int c = 0; c < n_coef; ++c) {
-          const double* row = inverse + c * n_basis;
+        Pair* l = reinterpret_cast<Pair*>(&coef_[static_cast<std::size_t>(i) * n_coef * n_row]);
+        if constexpr (n_coef == 1 || n_value_only > 0) {  // c0 directly: psi_0 = W (M^-1 b)_0
+          const double* row = &inverse_rows_[static_cast<std::size_t>(i) * n_coef * n_basis];
           double v = row[0] + row[1] * r0;
           if constexpr (D > 1) v += row[2] * r1;
           if constexpr (D > 2) v += row[3] * r2;
-          psi[c] = Pair{W * v, W * v};
+          const Pair psi = Pair{W * v, W * v};
+          for (int m = 0; m < (n_coef == 1 ? n_pair : n_value_only); ++m) l[m] += psi * f[m];
         }
-        Pair* l = reinterpret_cast<Pair*>(&coef_[static_cast<std::size_t>(i) * n_coef * n_row]);
-        for (int m = 0; m < n_pair; ++m)
-          for (int c = 0; c < (m < n_value_only ? 1 : n_coef); ++c) l[c * (n_row / 2) + m] += psi[c] * f[m];
+        if constexpr (n_coef > 1) {  // the loads W b_e f of Eq. 9, made coefficients per node below
+          Pair wb[n_basis];
+          wb[0] = Pair{W, W};
+          const double r[3] = {r0, r1, r2};
+          for (int a = 0; a < D; ++a) wb[1 + a] = Pair{W * r[a], W * r[a]};
+          for (int m = n_value_only; m < n_pair; ++m)
+            for (int e = 0; e < n_basis; ++e) l[e * (n_row / 2) + m] += wb[e] * f[m];
+        }
       });
     });
   };
@@ -288,8 +295,25 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     if (body_force) fits.template operator()<all_pairs, n_basis, velocity_pairs>();
     else fits.template operator()<no_body_pairs, n_basis, velocity_pairs>();
   }
+  // The fields summed as loads: none with the values alone, else all but the velocity pairs
+  // whose slopes are not read.
+  int first_load = n_row;
+  if (n_coef_ > 1) first_load = options_.extrapolated_spurious_velocity || options_.fitted_surface_velocity ? 0 : 2 * velocity_pairs;
   for_each_node(n_nodes, [&](std::int32_t i) {  // the node values c0 (Eq. 11)
     if (count_[i] == 0) return;
+    if (first_load < n_row) {  // c = M^-1 l (Eq. 10) for the fields summed as loads
+      const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * n_coef_ * n_basis];
+      double* c = &coef_[static_cast<std::size_t>(i) * n_coef_ * n_row];
+      for (int k = first_load; k < n_row; ++k) {
+        double load[n_basis];
+        for (int e = 0; e < n_basis; ++e) load[e] = c[e * n_row + k];
+        for (int r = 0; r < n_basis; ++r) {
+          double v = 0.0;
+          for (int e = 0; e < n_basis; ++e) v += rows[r * n_basis + e] * load[e];
+          c[r * n_row + k] = v;
+        }
+      }
+    }
     auto value = [&](int k) { return coefficient(i, k, 0); };
     for (int a = 0; a < D; ++a) velocity_[i][a] = value(a);
     density_[i] = value(D);

@@ -348,7 +348,8 @@ class Integrator {
   std::vector<std::uint8_t> held_;  ///< held_components()
   /// n_nodes x n_coef_ x n_basis: the first n_coef_ rows of each node's M^-1 (Eq. 10).
   std::vector<double> inverse_rows_;
-  /// n_nodes x n_coef_ x n_row (field fastest): c = M^-1 l of each field (Eq. 10), r in cells.
+  /// n_nodes x n_coef_ x n_row (field fastest): c = M^-1 l of each field (Eq. 10), r in cells
+  /// (during collect's fits, the loads l of the fields whose slopes are read).
   std::vector<double> coef_;
   int n_coef_ = 1;  ///< coefficients fitted: 1 (the values) or n_basis (with the slopes)
   std::vector<std::uint8_t> alpha_;
