@@ -578,6 +578,19 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     const double* axis_S = &cache_.axis_value[2 * q];
     Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
+    // The transpose of the stress transfer (docs/wls.md, departure 17), where its weight is a
+    // volume near the particle's own: a massless surface particle stores no power, and where the
+    // fits extrapolate (cells that a mirror plane fills up to a wall) the weight can be small or
+    // negative. Elsewhere the quadrature gradient (not formed where the transpose is taken).
+    bool transposed = false;
+    if (transpose && !is_surface(particles, static_cast<std::size_t>(p))) {
+      double w = 0.0;
+      const Eigen::Matrix<double, D, D> G = transposed_gradient_sum(static_cast<std::size_t>(p), w);
+      const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
+      transposed = w > V / transpose_band && w < V * transpose_band;
+      if (transposed) L = G / w;
+    }
+    const bool quadrature = from_quadrature && !transposed;
     double weight = 0.0;
     bool massless = false;  // a node with S_ip > 0 and no mass
     for_each_corner_slot<D>(axis_S, [&](const std::array<int, D>& k) __attribute__((always_inline)) {
@@ -591,7 +604,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
         for (int a = 0; a < D; ++a)
           for (int c = 0; c < D; ++c) G[c] *= a == c ? axis_S[6 * a + 3 + k[a]] : axis_S[6 * a + k[a]];
         L += v_new[i] * G.transpose();  // Eq. 29
-      } else if (node_gradient_weight_[i] > 0.0) {
+      } else if (quadrature && node_gradient_weight_[i] > 0.0) {
         // S-interpolated node means of the integration points' gradients (docs/wls.md), over
         // the nodes that have integration points around them.
         L += S * node_gradient_[i];
@@ -637,17 +650,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
         }
       }
     }
-    if (from_quadrature && weight > 0.0) L /= weight;
-    if (transpose && !is_surface(particles, static_cast<std::size_t>(p))) {
-      // The transpose of the stress transfer (docs/wls.md, departure 17), where its weight is a
-      // volume near the particle's own: a massless surface particle stores no power, and where
-      // the fits extrapolate (cells that a mirror plane fills up to a wall) the weight can be
-      // small or negative.
-      double w = 0.0;
-      const Eigen::Matrix<double, D, D> G = transposed_gradient_sum(static_cast<std::size_t>(p), w);
-      const double V = particles.volume0[p] * particles.deformation_gradient[p].determinant();
-      if (w > V / transpose_band && w < V * transpose_band) L = G / w;
-    }
+    if (quadrature && weight > 0.0) L /= weight;
     // Eq. 27 (FLIP), or PIC: V_p = sum S v+ (seed 002 Eq. 1.66; docs/wls.md, departure 11). With
     // XPIC the increment starts from the particle's projected velocity (departure 18), and a
     // surface particle may start from the fitted velocity at its position instead of its own.
