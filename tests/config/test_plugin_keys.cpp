@@ -64,7 +64,9 @@ TEST(PluginKeys, JoinTheirSectionsWhereTheyBelong) {
         << section;
   }
   for (const auto* k : section_keys("method"))
-    if (k->name == "smoothing_length") EXPECT_EQ(k->owner, "ugimp");
+    if (k->name == "smoothing_length") {
+      EXPECT_EQ(k->owner, "ugimp");
+    }
 }
 
 TEST(PluginKeys, AreReadCheckedAndWrittenBack) {

@@ -143,11 +143,13 @@ TEST(Materials, CorotationalLinearElasticIgnoresRotations) {
   auto m = make_material(config("linear_elastic", {{"lambda", lambda}, {"shear_modulus", G}}));
   auto small = make_material(config("linear_elastic", {{"lambda", lambda}, {"shear_modulus", G}}, "small_strain"));
   for (double angle : {0.01, 0.3, 1.5, 3.0, 6.0, 100.0}) {
-    for (const Eigen::Vector3d axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, -2, 0.5)}) {
+    for (const Eigen::Vector3d& axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, -2, 0.5)}) {
       const Mat3 R = rotation(axis, angle);
       EXPECT_LT(m->kirchhoff(R).norm(), 1e-6 * G) << angle;  // round-off of G (V - I)
       EXPECT_LT(std::abs(m->energy_density(R)), 1e-12 * G) << angle;
-      if (angle > 0.2) EXPECT_GT(small->kirchhoff(R).norm(), 1e-3 * G) << angle;
+      if (angle > 0.2) {
+        EXPECT_GT(small->kirchhoff(R).norm(), 1e-3 * G) << angle;
+      }
     }
   }
 }

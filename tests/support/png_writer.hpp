@@ -27,10 +27,10 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 inline void write_png(const std::string& path, int width, int height, int colour_type, int bit_depth,
                       const std::vector<unsigned>& samples,
                       const std::vector<png_color>& palette = {}) {
-  int channels = 1;
-  if (colour_type == PNG_COLOR_TYPE_GRAY_ALPHA) channels = 2;
-  if (colour_type == PNG_COLOR_TYPE_RGB) channels = 3;
-  if (colour_type == PNG_COLOR_TYPE_RGB_ALPHA) channels = 4;
+  const int channels = colour_type == PNG_COLOR_TYPE_GRAY_ALPHA ? 2
+                       : colour_type == PNG_COLOR_TYPE_RGB       ? 3
+                       : colour_type == PNG_COLOR_TYPE_RGB_ALPHA ? 4
+                                                                 : 1;  // const: not clobbered by setjmp
   if (samples.size() != static_cast<std::size_t>(width * height * channels))
     throw std::logic_error("write_png: wrong number of samples");
   std::FILE* fp = std::fopen(path.c_str(), "wb");

@@ -505,7 +505,9 @@ void check_linear_velocity(const std::string& kind) {
       if (!w.well_conditioned()[i]) continue;
       const Vec<D> x = sim.grid().node_position(i);
       EXPECT_NEAR((w.node_velocity()[i] - (v0 + A * x)).norm(), 0.0, 1e-11) << i;
-      if (slopes) EXPECT_NEAR((w.velocity_gradient_fit(i) - A).norm(), 0.0, 1e-10) << i;
+      if (slopes) {
+        EXPECT_NEAR((w.velocity_gradient_fit(i) - A).norm(), 0.0, 1e-10) << i;
+      }
       ++checked;
     }
     EXPECT_GT(checked, 20);

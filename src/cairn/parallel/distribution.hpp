@@ -132,7 +132,8 @@ class Distribution {
       const std::vector<char>& in = refresh_recv_[k];
       std::size_t offset = 0;
       for (std::int32_t slot : ghost_slot_[k]) {
-        std::memcpy(values.data() + static_cast<std::size_t>(slot) * row, in.data() + offset, row * sizeof(T));
+        std::memcpy(static_cast<void*>(values.data() + static_cast<std::size_t>(slot) * row), in.data() + offset,
+                    row * sizeof(T));
         offset += row * sizeof(T);
       }
     }

@@ -46,7 +46,7 @@ void unpack_values(std::vector<T>& values, int width, std::size_t first, std::si
   if (width == 0 || count == 0) return;
   const std::size_t bytes = count * static_cast<std::size_t>(width) * sizeof(T);
   if (offset + bytes > in.size()) throw std::runtime_error("particle transfer: short buffer");
-  std::memcpy(values.data() + first * static_cast<std::size_t>(width), in.data() + offset, bytes);
+  std::memcpy(static_cast<void*>(values.data() + first * static_cast<std::size_t>(width)), in.data() + offset, bytes);
   offset += bytes;
 }
 

@@ -35,16 +35,12 @@ void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>
   node_gradient_weight_.resize(n_nodes);
   if (transpose) {
     transpose_sum_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
-    transpose_weight_.resize(static_cast<std::size_t>(n_nodes) * n_basis);
   }
   for_each_node(n_nodes, [&](std::int32_t i) {
     node_gradient_[i].setZero();
     node_gradient_weight_[i] = 0.0;
     if (transpose)
-      for (int c = 0; c < n_basis; ++c) {
-        transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
-        transpose_weight_[static_cast<std::size_t>(i) * n_basis + c] = 0.0;
-      }
+      for (int c = 0; c < n_basis; ++c) transpose_sum_[static_cast<std::size_t>(i) * n_basis + c].setZero();
   });
   const Vec<D> inv_h = h_.cwiseInverse();
   for_each_region_coloured([&](std::int32_t r) {
@@ -56,6 +52,9 @@ void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>
       node_gradient_weight_[corner.node[k]] += w;
     }
     if (!transpose) return;
+    TransposeSum L_one;  // [L_q, 1]: the sum and its weight in one add
+    L_one.template head<D * D>() = Eigen::Map<const Eigen::Matrix<double, D * D, 1>>(L.data());
+    L_one[D * D] = 1.0;
     double sum = 0.0;
     const unsigned used = value_corners(corner, sum);
     const double scale = regions_[r].volume / sum;
@@ -68,8 +67,7 @@ void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>
       const double w = scale * corner.S[k];
       for (int c = 0; c < n_c; ++c) {
         const double beta = c == 0 ? 1.0 : local[c - 1] - ((k >> (c - 1)) & 1);
-        transpose_sum_[at + c] += (w * beta) * L;
-        transpose_weight_[at + c] += w * beta;
+        transpose_sum_[at + c] += (w * beta) * L_one;
       }
     }
   });
@@ -82,21 +80,12 @@ void Integrator<D>::gradient_sums(const Grid<D>& grid, const std::vector<Vec<D>>
     if (!transpose || count_[i] == 0) return;
     const std::size_t at = static_cast<std::size_t>(i) * n_basis;
     const double* rows = &inverse_rows_[static_cast<std::size_t>(i) * stride];
-    std::array<Eigen::Matrix<double, D, D>, n_basis> A;
-    std::array<double, n_basis> a;
-    for (int c = 0; c < n_c; ++c) {
-      A[c] = transpose_sum_[at + c];
-      a[c] = transpose_weight_[at + c];
-    }
+    std::array<TransposeSum, n_basis> A;
+    for (int c = 0; c < n_c; ++c) A[c] = transpose_sum_[at + c];
     for (int e = 0; e < n_basis; ++e) {
-      Eigen::Matrix<double, D, D> B = Eigen::Matrix<double, D, D>::Zero();
-      double b = 0.0;
-      for (int c = 0; c < n_c; ++c) {
-        B += rows[c * n_basis + e] * A[c];
-        b += rows[c * n_basis + e] * a[c];
-      }
+      TransposeSum B = TransposeSum::Zero();
+      for (int c = 0; c < n_c; ++c) B += rows[c * n_basis + e] * A[c];
       transpose_sum_[at + e] = B;
-      transpose_weight_[at + e] = b;
     }
   });
 }
@@ -109,25 +98,18 @@ Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p
   const std::int32_t* axis_node = &cache_.axis_node[q];
   const double* axis_W = &wide_[q];
   const double* axis_r = &offset_[q];
-  Eigen::Matrix<double, D, D> G = Eigen::Matrix<double, D, D>::Zero();
-  double w = 0.0;
+  TransposeSum G = TransposeSum::Zero();
   for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
     double W;
     const std::int32_t i = stencil_entry<D, 3>(k, axis_node, axis_W, W);
     if (W <= 0.0) return;
     const std::size_t at = static_cast<std::size_t>(i) * n_basis;
-    Eigen::Matrix<double, D, D> B = transpose_sum_[at];
-    double b = transpose_weight_[at];
-    for (int a = 0; a < D; ++a) {
-      const double r = axis_r[3 * a + k[a]];
-      B += r * transpose_sum_[at + 1 + a];
-      b += r * transpose_weight_[at + 1 + a];
-    }
+    TransposeSum B = transpose_sum_[at];
+    for (int a = 0; a < D; ++a) B += axis_r[3 * a + k[a]] * transpose_sum_[at + 1 + a];
     G += W * B;
-    w += W * b;
   });
-  weight = w;
-  return G;
+  weight = G[D * D];
+  return Eigen::Map<const Eigen::Matrix<double, D, D>>(G.data());
 }
 
 template void Integrator<1>::gradient_sums(const Grid<1>&, const std::vector<Vec<1>>&);

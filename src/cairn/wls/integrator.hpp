@@ -390,8 +390,10 @@ class Integrator {
     for (int k = 0; k < (1 << D); ++k) sum += corner.S[k];
     return (1U << (1 << D)) - 1;
   }
-  std::vector<Eigen::Matrix<double, D, D>> transpose_sum_;      ///< n_nodes x n_basis: B_ke (gradient_sums)
-  std::vector<double> transpose_weight_;                        ///< the same sums without L_q
+  /// n_nodes x n_basis: B_ke (gradient_sums), its D x D entries (column-major) and last the same
+  /// sum without L_q (the weight), side by side for the gather.
+  using TransposeSum = Eigen::Matrix<double, D * D + 1, 1>;
+  std::vector<TransposeSum, Eigen::aligned_allocator<TransposeSum>> transpose_sum_;
   std::vector<Eigen::Matrix<double, D, D>> node_gradient_;    ///< its S V-weighted node means
   std::vector<double> node_gradient_weight_;                  ///< sum S V around each node
   std::vector<Eigen::Matrix<double, D, D>> particle_gradient_;  ///< grad V_p (move_particles)

@@ -128,6 +128,6 @@ CAIRN_DECLARE_KEYS(wls, {"wls", {"method"}, {
       "update beyond the grid's), which split energy_error into the forces' and the "
       "velocity transfer's parts (docs/wls.md, \"Energy budget\"); two exact sums per "
       "step, about 2 % of the step.")
-      .by_default("false")}});
+      .by_default("false")}, {}, ""});  // no cross-key check; the keys at the section's end
 
 }  // namespace cairn::wls
