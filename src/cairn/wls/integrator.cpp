@@ -246,6 +246,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   // c = M^-1 l once per node: as many sums as coefficients, without forming psi per entry.
   // The velocity's slopes are read only by the extrapolated spurious and the fitted surface
   // velocity: without them the pairs that hold velocity components alone take c0 directly.
+  const bool velocity_slopes = options_.extrapolated_spurious_velocity || options_.fitted_surface_velocity;
   // The fields are added in pairs (GCC/Clang vector extensions, SSE2: the same operations per
   // field) over compile-time numbers of pairs and coefficients.
   using Pair = double __attribute__((vector_size(16), may_alias));
@@ -288,7 +289,7 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
   if (n_coef_ == 1) {
     if (body_force) fits.template operator()<all_pairs, 1, 0>();
     else fits.template operator()<no_body_pairs, 1, 0>();
-  } else if (options_.extrapolated_spurious_velocity || options_.fitted_surface_velocity) {
+  } else if (velocity_slopes) {
     if (body_force) fits.template operator()<all_pairs, n_basis, 0>();
     else fits.template operator()<no_body_pairs, n_basis, 0>();
   } else {
@@ -296,9 +297,8 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     else fits.template operator()<no_body_pairs, n_basis, velocity_pairs>();
   }
   // The fields summed as loads: none with the values alone, else all but the velocity pairs
-  // whose slopes are not read.
-  int first_load = n_row;
-  if (n_coef_ > 1) first_load = options_.extrapolated_spurious_velocity || options_.fitted_surface_velocity ? 0 : 2 * velocity_pairs;
+  // that took c0 directly.
+  const int first_load = n_coef_ == 1 ? n_row : velocity_slopes ? 0 : 2 * velocity_pairs;
   for_each_node(n_nodes, [&](std::int32_t i) {  // the node values c0 (Eq. 11)
     if (count_[i] == 0) return;
     if (first_load < n_row) {  // c = M^-1 l (Eq. 10) for the fields summed as loads
