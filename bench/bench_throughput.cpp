@@ -25,14 +25,14 @@ Config bench_config(const std::string& shape, const std::string& model, int cell
   c.grid.cell_size.assign(D, 1.0 / cells);
   c.method.shape = shape;
   MaterialConfig m;
-  m.name = "m";
+  m.name = "solid";
   m.model = model;
   m.numbers = {{"density", 1000.0}, {"youngs_modulus", 1e7}, {"poissons_ratio", 0.3}};
   if (model == "neo_hookean") m.strings["form"] = "ln_j";
   c.materials.push_back(m);
   BodyConfig b;
   b.name = "block";
-  b.material = "m";
+  b.material = "solid";
   b.shape.kind = "box";
   b.shape.min.assign(D, 0.2);
   b.shape.max.assign(D, 0.8);

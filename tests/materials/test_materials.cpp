@@ -10,7 +10,7 @@ namespace {
 MaterialConfig config(const std::string& model, std::map<std::string, double> numbers,
                       std::string form = "") {
   MaterialConfig m;
-  m.name = "m";
+  m.name = "solid";
   m.model = model;
   m.numbers = std::move(numbers);
   m.numbers["density"] = 1000.0;

@@ -148,8 +148,9 @@ Bytes in_child(const std::string& path, const std::function<void(Bytes&)>& read,
   Bytes in;
   in.data() = r.output;
   const char kind = in.get<char>();
-  const std::string memory = fmt::format("Gmsh ran out of the {:.3g} GiB a mesh file of {:.0f} bytes may take: a count "
-                                         "in the file larger than its content",
+  const std::string memory = fmt::format("Gmsh could not allocate what a count in the file asks for (negative, or more "
+                                         "than the {:.3g} GiB a mesh file of {:.0f} bytes may take): a count that does "
+                                         "not match the file's content",
                                          budget / (1u << 30), file_bytes);
   if (kind == 'I') {
     std::string file = in.get_string();

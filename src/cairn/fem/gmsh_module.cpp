@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <mutex>
+#include <new>
 #include <numbers>
 #include <stdexcept>
 #include <unordered_map>
@@ -44,6 +45,13 @@ class GmshSession {
 std::string current_error() {
   try {
     throw;
+  } catch (const std::bad_alloc&) {
+    // Also std::bad_array_new_length (a negative or overflowing count) and, below, a vector's
+    // std::length_error: what a damaged count in a file asks for. One text for all of them,
+    // which the reading's parent process recognises (gmsh_mesh.cpp, in_child).
+    return "std::bad_alloc";
+  } catch (const std::length_error&) {
+    return "std::bad_alloc";
   } catch (const std::exception& e) {
     return e.what();
   } catch (const std::string& s) {

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <new>
 #include <stdexcept>
 
 #include "cairn/geometry/text.hpp"
@@ -107,6 +108,13 @@ std::shared_ptr<const PointSet> read_point_h5(const std::string& path, int dimen
     }
   } catch (const std::runtime_error& e) {  // HDF5 failures (h5:: helpers)
     fail(e.what());
+  } catch (const std::bad_alloc&) {
+    // A damaged dataset size: the reading child's memory is limited (read_point_h5_in_child).
+    std::error_code ec;
+    fail(fmt::format("its datasets' sizes ask for more memory than a point file of {} bytes may take: a damaged size",
+                     std::filesystem::file_size(path, ec)));
+  } catch (const std::length_error&) {
+    fail("a dataset's size is larger than any array can hold: a damaged size");
   }
   return set;
 }
@@ -210,14 +218,16 @@ namespace {
 /// by cairn_fuzz_geometry); the child sends back the points or the error.
 std::shared_ptr<const PointSet> read_point_h5_in_child(const std::string& path, int dimension) {
   std::error_code ec;
-  const double bytes = static_cast<double>(std::filesystem::file_size(path, ec));
+  const auto size = std::filesystem::file_size(path, ec);
+  const double bytes = ec ? 0.0 : static_cast<double>(size);
+  const int timeout_seconds = hdf5_reading_seconds(bytes);
   const ChildResult r = run_in_child(
       [&](std::string& out) {
         limit_address_space((1u << 30) + 200.0 * bytes);
         auto put = [&](const void* p, std::size_t n) { put_bytes(out, p, n); };
         try {
           const auto set = read_point_h5(path, dimension);
-          out = "P";
+          out.assign(1, 'P');  // (not `out = "P"`: GCC 12 warns falsely on a one-character literal there)
           const std::uint64_t n[5] = {set->position.size(), set->volume.size(), set->velocity.size(),
                                       set->temperature.size(), set->stress.size()};
           put(n, sizeof n);
@@ -234,10 +244,10 @@ std::shared_ptr<const PointSet> read_point_h5_in_child(const std::string& path, 
         }
         return 0;
       },
-      300);
+      timeout_seconds);
   if (r.signal != 0 || r.timed_out || r.exit_code != 0 || r.output.empty())
-    throw std::invalid_argument(
-        fmt::format("point file '{}': the HDF5 library failed on it ({}): a damaged file", path, child_ending(r, 300)));
+    throw std::invalid_argument(fmt::format("point file '{}': the HDF5 library failed on it ({}): a damaged file", path,
+                                            child_ending(r, timeout_seconds)));
   if (r.output[0] == 'E') throw std::invalid_argument(r.output.substr(1));
   AnswerReader answer(r.output, 1);
   auto take = [&](void* p, std::size_t n) {

@@ -513,7 +513,9 @@ int checkpoint_dimension(const fs::path& path) {
 }
 
 void check_readable_by_hdf5(const fs::path& path) {
-  constexpr int timeout_seconds = 300;
+  std::error_code ec;
+  const auto bytes = fs::file_size(path, ec);
+  const int timeout_seconds = hdf5_reading_seconds(ec ? 0.0 : static_cast<double>(bytes));
   const ChildResult r = run_in_child(
       [&](std::string& out) {
         out = "read";  // or an error HDF5 reported, which the reader names in the parent

@@ -4,6 +4,7 @@
 // (docs/robustness.md, "Files from outside").
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -25,6 +26,14 @@ struct ChildResult {
 /// still catch a fault and exit with its own code: callers treat any exit code but the ones
 /// `work` returns as a crash. Throws std::runtime_error when no process can be started.
 ChildResult run_in_child(const std::function<int(std::string& out)>& work, int timeout_seconds);
+
+/// The time a child reading a file of `bytes` bytes with HDF5 may take: 5 s and 1 s per 10 MB.
+/// A reading is linear in the file's size, and far faster than that (a 1 MB checkpoint is read
+/// and hashed in milliseconds); HDF5 1.10 loops without end on some damaged global heaps (found
+/// by cairn_fuzz_checkpoint), and such a file is refused in seconds rather than minutes.
+inline int hdf5_reading_seconds(double bytes) {
+  return 5 + static_cast<int>(std::min(std::max(bytes, 0.0), 1.0e12) / 1.0e7);
+}
 
 /// How a child that failed ended, for a message: "it did not finish in T s", "signal S" or
 /// "exit code E".
