@@ -563,6 +563,7 @@ std::string random_program(std::mt19937_64& rng) {
 
 int main(int argc, char** argv) {
   double seconds = 10.0;
+  long long max_inputs = -1;
   int keep_going = 0;  // > 0: go on after findings, saving up to this many different ones
   std::uint64_t seed = 1;
   std::string seed_folder = CAIRN_CHECKPOINT_SEEDS;
@@ -571,12 +572,13 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--seconds") seconds = std::atof(argv[i + 1]);
     else if (a == "--seed") seed = std::strtoull(argv[i + 1], nullptr, 10);
+    else if (a == "--inputs") max_inputs = std::atoll(argv[i + 1]);
     else if (a == "--keep-going") keep_going = std::atoi(argv[i + 1]);
     else if (a == "--seeds") seed_folder = argv[i + 1];
     else if (a == "--corpus") folders.emplace_back(argv[i + 1]);
     else {
-      std::fprintf(stderr, "usage: cairn_fuzz_checkpoint [--seconds S] [--seed N] [--keep-going N] --seeds DIR "
-                           "[--corpus DIR]...\n");
+      std::fprintf(stderr, "usage: cairn_fuzz_checkpoint [--seconds S] [--inputs N] [--seed N] [--keep-going N] "
+                           "--seeds DIR [--corpus DIR]...\n");
       return 2;
     }
   }
@@ -617,7 +619,7 @@ int main(int argc, char** argv) {
     for (int k = 0; k < flips; ++k) bytes[rng() % bytes.size()] ^= static_cast<char>(1u << (rng() % 8));
     return bytes;
   };
-  const fuzz::Campaign c = fuzz::run_campaign(seconds, keep_going, seed, next, exercise, findings);
+  const fuzz::Campaign c = fuzz::run_campaign(seconds, max_inputs, keep_going, seed, next, exercise, findings);
   std::printf("fuzz_checkpoint: %zu seeds restored, %lld corpus files replayed, %lld mutated checkpoints in %.1f s "
               "(seed %llu), %lld of them restored, slowest %lld ms: %s\n",
               seeds.size(), replayed, c.inputs, c.seconds, static_cast<unsigned long long>(seed), c.accepted,

@@ -279,6 +279,7 @@ class Mutator {
 
 int main(int argc, char** argv) {
   double seconds = 10.0;
+  long long max_inputs = -1;
   int keep_going = 0;  // > 0: go on after findings, saving up to this many different ones
   std::uint64_t seed = 1;
   std::vector<std::string> folders;
@@ -286,10 +287,12 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--seconds") seconds = std::atof(argv[i + 1]);
     else if (a == "--seed") seed = std::strtoull(argv[i + 1], nullptr, 10);
+    else if (a == "--inputs") max_inputs = std::atoll(argv[i + 1]);
     else if (a == "--keep-going") keep_going = std::atoi(argv[i + 1]);
     else if (a == "--corpus") folders.emplace_back(argv[i + 1]);
     else {
-      std::fprintf(stderr, "usage: cairn_fuzz_geometry [--seconds S] [--seed N] [--keep-going N] --corpus DIR...\n");
+      std::fprintf(stderr,
+                   "usage: cairn_fuzz_geometry [--seconds S] [--inputs N] [--seed N] [--keep-going N] --corpus DIR...\n");
       return 2;
     }
   }
@@ -321,7 +324,8 @@ int main(int argc, char** argv) {
   }
   std::sort(seeds.begin(), seeds.end());
   Mutator mutator(seed, seeds);
-  const fuzz::Campaign c = fuzz::run_campaign(seconds, keep_going, seed, [&] { return mutator.next(); }, exercise, findings);
+  const fuzz::Campaign c =
+      fuzz::run_campaign(seconds, max_inputs, keep_going, seed, [&] { return mutator.next(); }, exercise, findings);
   std::printf("fuzz_geometry: %lld corpus files replayed, %lld mutated files from %zu seeds in %.1f s (seed %llu), "
               "%lld of them read, slowest %lld ms: %s\n",
               replayed, c.inputs, seeds.size(), c.seconds, static_cast<unsigned long long>(seed), c.accepted,

@@ -135,16 +135,21 @@ struct Campaign {
   int findings = 0;  // different ones
 };
 
-/// Exercise next() for `seconds`: `exercise` returns 1 (accepted), 0 (refused cleanly) or -1
-/// (a finding, described in `what`); an input over 10 s is a hang. Stops at the first finding,
-/// or with keep_going > 0 after that many different ones.
-inline Campaign run_campaign(double seconds, int keep_going, std::uint64_t seed, const std::function<std::string()>& next,
+/// Exercise next() for `max_inputs` inputs (negative: no limit) or `seconds`, whichever ends
+/// first: `exercise` returns 1 (accepted), 0 (refused cleanly) or -1 (a finding, described in
+/// `what`); an input over 10 s is a hang. Stops at the first finding, or with keep_going > 0
+/// after that many different ones. ctest gives a number of inputs (and a time far beyond it), so
+/// that every machine runs the same inputs and a finding the campaign can reach shows on all of
+/// them, not only on a fast one.
+inline Campaign run_campaign(double seconds, long long max_inputs, int keep_going, std::uint64_t seed,
+                             const std::function<std::string()>& next,
                              const std::function<int(const std::string&, std::string&)>& exercise, Findings& findings) {
   Campaign c;
   std::set<std::string> kinds;
   std::string what;
   const auto start = std::chrono::steady_clock::now();
   for (;; ++c.inputs) {
+    if (max_inputs >= 0 && c.inputs >= max_inputs) break;
     if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > seconds) break;
     current = next();
     const auto t0 = std::chrono::steady_clock::now();
