@@ -96,8 +96,8 @@ Eigen::Matrix<double, D, D> Integrator<D>::transposed_gradient_sum(std::size_t p
   // the particle's wide stencil: W_kp sum_e b_e B_ke with the node sums gradient_sums folded.
   const std::size_t q = p * D * 3;
   const std::int32_t* axis_node = &cache_.axis_node[q];
-  const double* axis_W = &wide_[q];
-  const double* axis_r = &offset_[q];
+  double axis_W[3 * D], axis_r[3 * D];
+  wide_stencil(p, axis_W, axis_r);
   TransposeSum G = TransposeSum::Zero();
   for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
     double W;

@@ -83,12 +83,11 @@ template <int D>
 void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& particles) {
   // Per axis and particle the three nodes around the nearest one: their storage offsets and the
   // narrow S, G factors in the cache's tensor layout (S_pi = prod_a S_a, G_pi,b = prod_a (a == b ?
-  // G_a : S_a)), the wide W factors and x_p - x_i in cells here; the 3^D products are formed
+  // G_a : S_a)), and x_p - x_n to the nearest node here (wide_stencil forms W and x_p - x_i from it); the 3^D products are formed
   // where they are used (W, S and G are tensor products, seed 001 Sec. 3.1).
   const auto n = static_cast<std::int64_t>(particles.n());
   cache_.reserve_tensor(particles.n(), 3);
-  wide_.resize(static_cast<std::size_t>(n) * D * 3);
-  offset_.resize(static_cast<std::size_t>(n) * D * 3);
+  local_.resize(static_cast<std::size_t>(n) * D);
   const Vec<D> inv_h = h_.cwiseInverse();
   std::int64_t first_bad = std::numeric_limits<std::int64_t>::max();
 #pragma omp parallel
@@ -107,6 +106,7 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
         if (!periodic_[a]) outside |= !(cell >= 0 && cell < n_cells_[a]);
         const int nearest = static_cast<int>(std::floor(xi[a] + 0.5));
         const double local = xi[a] - cell;
+        local_[static_cast<std::size_t>(p) * D + a] = xi[a] - nearest;
         std::int32_t* node = &cache_.axis_node[q + 3 * a];
         double* S = &cache_.axis_value[2 * q + 6 * a];
         // The nodes nearest - 1 .. nearest + 1 start at the cell's lower node (shift 1) or one
@@ -117,12 +117,6 @@ void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& part
         const double gradient[4] = {0.0, -inv_h[a], inv_h[a], 0.0};
         for (int k = 0; k < 3; ++k) {
           const int j = nearest - 1 + k;
-          const double r = xi[a] - j;  // x_p - x_i in cells: in [0.5, 1.5), [-0.5, 0.5), [-1.5, -0.5)
-          offset_[q + 3 * a + k] = r;
-          // Eq. 4 with h = 1 on each node's known branch (wide_weight(r, 1) to the bit; at
-          // r = -0.5 both branches give 0.5, at r = -1.5 both give 0).
-          const double w = 1.5 - std::abs(r);
-          wide_[q + 3 * a + k] = k == 1 ? 0.75 - r * r : w * w / 2.0;
           S[k] = shape[k + shift];
           S[3 + k] = gradient[k + shift];
           node[k] = grid.axis_index(a, j);
@@ -186,8 +180,8 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
     const std::int32_t* axis_node = &cache_.axis_node[q];
     const double* axis_S = &cache_.axis_value[2 * q];
-    const double* axis_W = &wide_[q];
-    const double* axis_r = &offset_[q];
+    double axis_W[3 * D], axis_r[3 * D];
+    wide_stencil(static_cast<std::size_t>(p), axis_W, axis_r);
     const bool surface = is_surface(particles, static_cast<std::size_t>(p));
     const double flag = surface ? 1.0 : 2.0;
     const Vec<D>& x_p = particles.position[p];
@@ -254,8 +248,8 @@ void Integrator<D>::collect(const Grid<D>& grid, const Particles<D>& particles,
     scatter(cache_, [&](std::int32_t p, const auto&) {
       const std::size_t q = static_cast<std::size_t>(p) * D * 3;
       const std::int32_t* axis_node = &cache_.axis_node[q];
-      const double* axis_W = &wide_[q];
-      const double* axis_r = &offset_[q];
+      double axis_W[3 * D], axis_r[3 * D];
+      wide_stencil(static_cast<std::size_t>(p), axis_W, axis_r);
       const Pair* f = reinterpret_cast<const Pair*>(&particle_fields_[static_cast<std::size_t>(p) * n_row]);
       for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
         double W;

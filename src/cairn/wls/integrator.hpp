@@ -323,8 +323,29 @@ class Integrator {
   std::array<bool, D> periodic_{};  ///< the grid wraps the axis (positions are not wrapped)
   bool any_periodic_ = false;
   TransferCache<D> cache_;             ///< tensor layout, width 3: node offsets, S and G per axis
-  std::vector<double> wide_;           ///< n x D x 3: W per axis (Eq. 4)
-  std::vector<double> offset_;         ///< n x D x 3: x_p - x_i in cells per axis
+  /// n x D: x_p - x_n in cells along each axis, n the particle's nearest node (in [-0.5, 0.5)):
+  /// wide_stencil forms its wide weights and offsets from it.
+  std::vector<double> local_;
+  /// Particle p's wide weights W (Eq. 4, h = 1) and offsets r = x_p - x_i in cells of the nodes
+  /// nearest - 1, nearest, nearest + 1 along each axis (3 per axis, axis-major): recomputed from
+  /// local_ where they are read rather than stored (D doubles per particle instead of 6 D; the same bits:
+  /// x_p - x_i = (x_p - x_n) + (n - i) rounds the same real number, x_p - x_n being exact).
+  [[gnu::always_inline]] void wide_stencil(std::size_t p, double* axis_W, double* axis_r) const {
+    const double* local = &local_[p * D];
+    for (int a = 0; a < D; ++a) {
+      const double r1 = local[a];
+      const double r0 = r1 + 1.0, r2 = r1 - 1.0;
+      axis_r[3 * a] = r0;
+      axis_r[3 * a + 1] = r1;
+      axis_r[3 * a + 2] = r2;
+      // Eq. 4 with h = 1 on each node's known branch (wide_weight(r, 1) to the bit; at r = -0.5
+      // both branches give 0.5, at r = -1.5 both give 0).
+      const double w0 = 1.5 - std::abs(r0), w2 = 1.5 - std::abs(r2);
+      axis_W[3 * a] = w0 * w0 / 2.0;
+      axis_W[3 * a + 1] = 0.75 - r1 * r1;
+      axis_W[3 * a + 2] = w2 * w2 / 2.0;
+    }
+  }
   std::vector<double> particle_fields_;///< n x n_row per-particle values of the step
   // node accumulators and results
   /// What each stencil entry adds to its node in the moment pass, in one place (one cache line in

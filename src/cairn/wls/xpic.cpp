@@ -59,8 +59,8 @@ void Integrator<D>::xpic_projection(const Grid<D>& grid, const std::vector<doubl
     scatter(cache_, [&](std::int32_t p, const auto&) {
       const std::size_t q = static_cast<std::size_t>(p) * D * 3;
       const std::int32_t* axis_node = &cache_.axis_node[q];
-      const double* axis_W = &wide_[q];
-      const double* axis_r = &offset_[q];
+      double axis_W[3 * D], axis_r[3 * D];
+      wide_stencil(static_cast<std::size_t>(p), axis_W, axis_r);
       const Vec<D>& s = xpic_particle_[static_cast<std::size_t>(p)];
       for_each_slot<D>([&](const std::array<int, D>& k) __attribute__((always_inline)) {
         double W;
