@@ -83,8 +83,9 @@ template <int D>
 void Integrator<D>::build_stencils(const Grid<D>& grid, const Particles<D>& particles) {
   // Per axis and particle the three nodes around the nearest one: their storage offsets and the
   // narrow S, G factors in the cache's tensor layout (S_pi = prod_a S_a, G_pi,b = prod_a (a == b ?
-  // G_a : S_a)), and x_p - x_n to the nearest node here (wide_stencil forms W and x_p - x_i from it); the 3^D products are formed
-  // where they are used (W, S and G are tensor products, seed 001 Sec. 3.1).
+  // G_a : S_a)), and x_p - x_n to the nearest node n here (wide_stencil forms W and x_p - x_i from
+  // it); the 3^D products are formed where they are used (W, S and G are tensor products, seed 001
+  // Sec. 3.1).
   const auto n = static_cast<std::int64_t>(particles.n());
   cache_.reserve_tensor(particles.n(), 3);
   local_.resize(static_cast<std::size_t>(n) * D);
