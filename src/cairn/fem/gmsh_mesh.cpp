@@ -141,9 +141,9 @@ Bytes in_child(const std::string& path, const std::function<void(Bytes&)>& read,
       timeout_seconds);
   if (r.timed_out) fail(fmt::format("Gmsh did not finish reading it in {} s", timeout_seconds));
   if (r.signal != 0)
-    fail(fmt::format("Gmsh crashed reading it (signal {}): a malformed mesh, e.g. an element whose node is not "
+    fail(fmt::format("Gmsh crashed reading it (signal {}{}): a malformed mesh, e.g. an element whose node is not "
                      "defined in $Nodes",
-                     r.signal));
+                     r.signal, child_said(r)));
   if (r.exit_code != 0 || r.output.empty()) fail("the process reading it with Gmsh ended without an answer");
   Bytes in;
   in.data() = r.output;

@@ -432,7 +432,7 @@ std::shared_ptr<const SurfaceMesh> read_surface_mesh(const std::string& path, co
   if (oriented.signal != 0 || oriented.timed_out || oriented.exit_code != 0 ||
       oriented.output.size() != mesh.number_of_faces())
     fail(path, "CGAL failed to orient the surface to bound a volume (a nearly degenerate surface: corners or faces "
-               "almost on each other?)");
+               "almost on each other?" + child_said(oriented) + ")");
   std::vector<Mesh::Face_index> to_turn;
   for (auto f : faces(mesh))
     if (oriented.output[f.idx()] == '1') to_turn.push_back(f);

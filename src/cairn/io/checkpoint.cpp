@@ -541,8 +541,7 @@ void check_readable_by_hdf5(const fs::path& path) {
            r.output.substr(1) + " (a damaged checkpoint)");
   if (r.signal != 0 || (!r.timed_out && (r.exit_code != 0 || r.output != "read")))
     refuse(path, "", "a checkpoint the HDF5 library can read",
-           r.signal != 0 ? fmt::format("a file on which it crashed (signal {}): a damaged checkpoint", r.signal)
-                         : fmt::format("a file on which it crashed (exit code {}): a damaged checkpoint", r.exit_code));
+           fmt::format("a file on which it crashed ({}): a damaged checkpoint", child_ending(r, timeout_seconds)));
   if (r.timed_out)
     refuse(path, "", "a checkpoint the HDF5 library can read",
            fmt::format("a file it did not finish reading in {} s: a damaged checkpoint", timeout_seconds));

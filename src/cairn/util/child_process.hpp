@@ -17,7 +17,20 @@ struct ChildResult {
   int signal = 0;          ///< the signal that ended it (0: it exited)
   int exit_code = 0;       ///< its exit code when it exited
   std::string output;      ///< what `work` put in its `out`
+  /// What the child wrote to its standard error (its last child_errors_kept bytes): a crash
+  /// inside a library prints there ("free(): invalid next size (fast)" from glibc when Gmsh
+  /// corrupts its heap on a damaged mesh), and the caller's message, not that line, is what the
+  /// user should see first. Empty in sanitizer builds, whose children keep the standard error
+  /// so that their reports stay visible.
+  std::string errors;
 };
+
+/// How much of a child's standard error ChildResult::errors keeps (the end of it).
+inline constexpr std::size_t child_errors_kept = 4096;
+
+/// Whether run_in_child keeps its children's standard error in ChildResult::errors (false in
+/// sanitizer builds, whose children write to the process's standard error).
+bool child_errors_captured();
 
 /// Run `work` in a forked child and wait for it at most `timeout_seconds`: the child's exit code
 /// is what `work` returns (an exception leaving it: 125), and `out` comes back as output. Only
@@ -36,8 +49,12 @@ inline int hdf5_reading_seconds(double bytes) {
 }
 
 /// How a child that failed ended, for a message: "it did not finish in T s", "signal S" or
-/// "exit code E".
+/// "exit code E", followed by child_said.
 std::string child_ending(const ChildResult& result, int timeout_seconds);
+
+/// The last line the child wrote to its standard error, as `; it printed "..."` (at most 200
+/// characters of it), or nothing when it wrote none.
+std::string child_said(const ChildResult& result);
 
 /// A child's answer as packed binary values: the child appends them (put), the parent reads
 /// them back in the same order (take).
