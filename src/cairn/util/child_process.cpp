@@ -113,8 +113,16 @@ ChildResult run_in_child(const std::function<int(std::string& out)>& work, int t
   }
   if (p[0].fd >= 0) ::close(p[0].fd);
   if (result.timed_out) ::kill(child, SIGKILL);
-  // What is left of its standard error: the child has ended (or been killed), so the pipe ends.
+  // What is left of its standard error: the child has ended (or been killed), so the pipe ends,
+  // unless a process the child started holds it: then no more than a second's wait.
   for (char buffer[65536]; p[1].fd >= 0;) {
+    const int ready = ::poll(&p[1], 1, 1000);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) {
+      ::close(p[1].fd);
+      p[1].fd = -1;
+      break;
+    }
     const ssize_t n = ::read(p[1].fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
