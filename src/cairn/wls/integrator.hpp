@@ -326,7 +326,7 @@ class Integrator {
   /// n x D: x_p - x_n in cells along each axis, n the particle's nearest node (in [-0.5, 0.5)):
   /// wide_stencil forms its wide weights and offsets from it.
   std::vector<double> local_;
-  /// Particle p's wide weights W (Eq. 4, h = 1) and offsets r = x_p - x_i in cells of the nodes
+  /// Particle p's wide weights W (seed 001 Eq. 4, h = 1) and offsets r = x_p - x_i in cells of the nodes
   /// nearest - 1, nearest, nearest + 1 along each axis (3 per axis, axis-major): recomputed from
   /// local_ where they are read rather than stored (D doubles per particle instead of 6 D; the same bits:
   /// x_p - x_i = (x_p - x_n) + (n - i) rounds the same real number, x_p - x_n being exact).
