@@ -223,6 +223,31 @@ def wls_plate_hole(cairn, source, out):
           f"wls_plate_hole: at the hole's side sigma_yy {s[side, 1].mean():.3f} T (compressed; Kirsch -1 T at the hole)")
 
 
+def wls_two_blocks(cairn, source, out):
+    # As it is (about a second): the blocks as elastic bars touch at 4 mm / (2 v), stay in contact
+    # for 2 L / c and press with rho c v H (per metre of thickness).
+    run(cairn, source, "wls_two_blocks.toml", out, [])
+    h = history(out)
+    c, v, L, H, h_cell = math.sqrt(1.0e7 / 1500.0), 0.8165, 0.05, 0.02, 2.0e-3
+    active = np.nonzero(h["contact_active"] > 0)[0]
+    check(len(active) > 0, "wls_two_blocks: the blocks came into contact")
+    first = active[0]
+    after = np.nonzero(h["contact_active"][first:] == 0)[0]
+    check(len(after) > 0, "wls_two_blocks: and left it")
+    last = first + after[0]
+    touch, duration = h["time"][first], h["time"][last] - h["time"][first]
+    check(abs(touch - 0.004 / (2 * v)) < 0.1 * h_cell / (2 * v),
+          f"wls_two_blocks: contact from {touch * 1e3:.3f} ms (the surfaces meet at {0.004 / (2 * v) * 1e3:.3f} ms)")
+    check(abs(duration - 2 * L / c) < 0.1 * 2 * L / c,
+          f"wls_two_blocks: in contact for {duration * 1e3:.3f} ms (2 L / c = {2 * L / c * 1e3:.3f} ms)")
+    force = -h["contact_left_right_x"][first:last].mean()
+    check(abs(force - 1500.0 * c * v * H) < 0.15 * 1500.0 * c * v * H,
+          f"wls_two_blocks: mean contact force {force:.0f} N/m (rho c v H = {1500.0 * c * v * H:.0f} N/m)")
+    _, end = snapshots(out)[-1]
+    left, right = mean_velocity(end["left"], 0), mean_velocity(end["right"], 0)
+    check(left < -0.8 * v and right > 0.8 * v, f"wls_two_blocks: the blocks leave at {left:.3f} and {right:.3f} m/s")
+
+
 def tutorial(cairn, source, out):
     """docs/tutorial.md builds examples/disk_wall.toml block by block: its TOML blocks put
     together must resolve to the same input (the output folder aside)."""
@@ -252,7 +277,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="cairn_examples_") as tmp:
         try:
             for case in (tutorial, disk_wall, falling_cube, taylor_bar, friction_block, meshed_projectile, plate_with_holes,
-                         wls_plate_hole):
+                         wls_plate_hole, wls_two_blocks):
                 print(case.__name__)
                 case(cairn, source, os.path.join(tmp, case.__name__))
         except CheckFailed as e:

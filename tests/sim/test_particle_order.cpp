@@ -161,7 +161,7 @@ TEST(ParticleOrder, SortedRunsAreBitIdenticalToCreationOrder) {
 TEST(ParticleOrder, SortedWlsRunsAreBitIdenticalToCreationOrder) {
   // The WLS engine (seed 001) colours its particles in its own cache; sorted by that colouring it
   // must add every node's particles in the same order as a run in creation order. The blocks as
-  // above without contact (WLS has none), the traction on, 2 x 20 000 particles.
+  // above without contact (WLS bodies in contact keep their storage order), the traction on, 2 x 20 000 particles.
   std::string wls_input = input;
   wls_input = wls_input.substr(0, wls_input.find("[contact]")) + wls_input.substr(wls_input.find("[output]"));
   std::map<std::int64_t, State> result[2];

@@ -114,11 +114,8 @@ TEST(RunLoop, WlsEnergyBudgetRestartsBitIdentical) {
   expect_bit_identical_restart("wls_budget", {"method.integration=\"wls\"", "method.energy_budget=true"});
 }
 
-TEST(RunLoop, ContactReleasedBySeparationRestartsBitIdentical) {
-  // [contact] release = "separation" keeps a pair in contact by the last step's record: the
-  // checkpoint stores the record (/contact/in_contact). Without it this restart, from the middle
-  // of the impact, differs from the uninterrupted run in the history's next rows.
-  const char* disks = R"toml(
+/// Two disks meeting at +-30 m/s under Coulomb friction (body mode), checkpoints mid-impact.
+const char* const contact_disks = R"toml(
 [simulation]
 dimension = 2
 end_time = 3.0e-4
@@ -159,7 +156,21 @@ every = 1.5e-4
 history_every = 3.0e-5
 checkpoint_every = 1.5e-4
 )toml";
-  expect_bit_identical_restart("contact_release", {}, disks);
+
+TEST(RunLoop, ContactReleasedBySeparationRestartsBitIdentical) {
+  // [contact] release = "separation" keeps a pair in contact by the last step's record: the
+  // checkpoint stores the record (/contact/in_contact). Without it this restart, from the middle
+  // of the impact, differs from the uninterrupted run in the history's next rows.
+  expect_bit_identical_restart("contact_release", {}, contact_disks);
+}
+
+TEST(RunLoop, WlsContactRestartsBitIdentical) {
+  // WLS bodies in contact (docs/wls.md, "Contact"): each field's integrator rebuilds everything
+  // from the particles every step, so the particles and the contact record are all a restart
+  // from the middle of the impact needs.
+  expect_bit_identical_restart("wls_contact",
+                               {"method.integration=\"wls\"", "method.time_integration=\"central_difference\""},
+                               contact_disks);
 }
 
 int run_cli(const std::string& args, const fs::path& log) {

@@ -398,7 +398,7 @@ void Contact<D>::exchange_cloud_particles(const Particles<D>& particles, const T
       put(out, particles.position[p]);
       if (need_radius_) {
         put(out, particles.deformation_gradient[p]);
-        put(out, particles.size0[p]);
+        put(out, edges(particles, p));
       }
       for (; i < j; ++i) {
         put(out, entries[i].row);
@@ -525,11 +525,11 @@ void Contact<D>::geometry(std::size_t c, const Particles<D>& particles, const st
       const std::int32_t r = cloud_p[k];  // (p >= 0: this rank's particle, else ghost -1 - r)
       if (column > 0.0 && (cloud_x[k] - cloud_x[k].dot(n) * n).norm() > column) continue;
       const auto g = static_cast<std::size_t>(-1 - r);
-      const Vec<D>& size0 = r >= 0 ? particles.size0[static_cast<std::size_t>(r)] : ghosts_.size0[g];
+      const Vec<D> size0 = r >= 0 ? edges(particles, static_cast<std::size_t>(r)) : ghosts_.size0[g];
       const Mat3& F = r >= 0 ? particles.deformation_gradient[static_cast<std::size_t>(r)] : ghosts_.deformation_gradient[g];
       Vec3 R0 = Vec3::Ones();
       for (int a = 0; a < D; ++a) R0[a] = 0.5 * size0[a];
-      const double R = contact::deformed_radius(F, R0, n, D);
+      const double R = size0.isZero() ? 0.0 : contact::deformed_radius(F, R0, n, D);  // (a point: no radius)
       const double xn = cloud_x[k].dot(n);
       if (cloud_c[k] < 0) max_a = std::max(max_a, xn + R);
       else min_b = std::min(min_b, xn - R);

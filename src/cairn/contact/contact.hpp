@@ -43,6 +43,12 @@ class Contact {
   [[nodiscard]] std::int32_t field_of(const Particles<D>& particles, std::size_t p) const {
     return by_body_ ? particles.body[p] : particles.material[p];
   }
+  /// The initial edges of particle p's inscribed ellipse/ellipsoid in the LR separation (Eq. 25,
+  /// R_0 half of them): its domain, or none for a particle of zero volume (a WLS surface
+  /// particle, a point on the body's surface; docs/wls.md, "Contact").
+  [[nodiscard]] static Vec<D> edges(const Particles<D>& particles, std::size_t p) {
+    return particles.volume0[p] == 0.0 ? Vec<D>::Zero() : particles.size0[p];
+  }
 
   /// Find the contact nodes and their normals and separations from the fields' masses
   /// (slots) and the particles (seed 004 Sec. 2.3, 3.1).

@@ -29,6 +29,7 @@
 #include "cairn/sim/simulation.hpp"
 #include "cairn/sim/thread_tuner.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/fields.hpp"
 #include "cairn/wls/integrator.hpp"
 
 namespace cairn {
@@ -575,7 +576,9 @@ class MpmEngine final : public Engine {
       snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), nullptr, nullptr, nullptr,
                        order.empty() ? nullptr : &order);
     // The regions of the last step (none before the first step).
-    if (cells_) cells_->write(wls::region_points(*sim_.wls()), sim_.time(), sim_.step_count());
+    if (cells_)
+      cells_->write(sim_.wls_fields() ? wls::region_points(*sim_.wls_fields()) : wls::region_points(*sim_.wls()),
+                    sim_.time(), sim_.step_count());
   }
 
 

@@ -23,6 +23,7 @@
 #include "cairn/sim/stress_timing.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/fields.hpp"
 #include "cairn/wls/integrator.hpp"
 
 namespace cairn {
@@ -39,7 +40,11 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
                                   "(simulation.mode = \"plane_stress\"); use plane strain or 3D");
     damping_time_.push_back(m->damping_time());
   }
-  ShapeContext ctx{config_.method, D};
+  // WLS bodies in contact: the contact's point clouds are the particles whose narrow shape S
+  // (seed 001 Eq. 5, the linear hat) reaches the node, whatever method.shape (unused by WLS).
+  MethodConfig shape_method = config_.method;
+  if (config_.method.integration == "wls" && config_.contact.enabled()) shape_method.shape = "linear";
+  ShapeContext ctx{shape_method, D};
   shape_ = make_shape_family<D>(ctx);
   scheme_ = SchemeRegistry<D>::instance().create("update scheme", config_.method.update, config_.method);
   flip_ = SchemeRegistry<D>::instance().create("update scheme", "flip", config_.method);
@@ -233,7 +238,6 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     // The WLS method (seed 001) replaces the particle transfers; features that act through
     // them are not defined for it (docs/wls.md says why for each).
     const char* unsupported = D == 1                          ? "a 1D simulation"
-                              : config_.contact.enabled()     ? "[contact]"
                               : config_.thermal.conduction    ? "[thermal] conduction"
                                                               : nullptr;
     if (unsupported)
@@ -278,7 +282,23 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
         o.mirror[f] = std::abs(particles_.position[p][a] - plane) < 0.5 * grid_.cell_size()[a];
     }
     o.thickness = config_.simulation.thickness;
+    if (contact_) {
+      // WLS bodies in contact (wls/fields.hpp): what acts on one node field after the grid
+      // update, or on the particles through the first correction, is defined for one field
+      // only (docs/wls.md, "Contact").
+      const char* alone = !config_.tractions.empty()                  ? "[[traction]]"
+                          : o.filter_acceleration                     ? "method.filter_acceleration"
+                          : o.hourglass_damping > 0.0                 ? "method.hourglass_damping"
+                          : o.xpic_order > 0                          ? "method.particle_velocity = \"xpic\""
+                          : o.energy_budget                           ? "method.energy_budget"
+                          : config_.contact.first_correction == "impulse" ? "contact.first_correction = \"impulse\""
+                                                                      : nullptr;
+      if (alone)
+        throw std::invalid_argument(std::string("method.integration = \"wls\" with [contact] does not support ") +
+                                    alone + " (docs/wls.md, \"Contact\")");
+    }
     wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
+    if (contact_) wls_fields_ = std::make_unique<wls::Fields<D>>(grid_, o, contact_->n_fields(), wls_.get());
   }
 
   if (!config_.body_force.expression.empty()) {
@@ -304,10 +324,15 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
   allocate_nodes();
   if (wls_) {
     // The initial node fields and integration regions, so that output at t = 0 shows them.
-    wls_->build_stencils(grid_, particles_);
     compute_body_forces();
-    wls_->collect(grid_, particles_, material_density_, body_force_.empty() ? nullptr : &body_acceleration_,
-                  nodes_, body_force_.empty() ? nullptr : &node_body_force_);
+    const std::vector<Vec<D>>* body = body_force_.empty() ? nullptr : &body_acceleration_;
+    if (wls_fields_) {
+      wls_fields_->split(particles_, field_offset_, grid_.n_nodes(), body);
+      wls_fields_->collect(grid_, material_density_, body != nullptr, nodes_, body ? &node_body_force_ : nullptr);
+    } else {
+      wls_->build_stencils(grid_, particles_);
+      wls_->collect(grid_, particles_, material_density_, body, nodes_, body ? &node_body_force_ : nullptr);
+    }
   }
 }
 
@@ -392,7 +417,9 @@ void Simulation<D>::keep_particles_sorted(bool setup) {
   // in id order whatever their storage order (transfer/colouring.cpp), and every other particle
   // stage works particle by particle or sums exactly, so the results do not change by a bit.
   const std::size_t n = particles_.n();
-  if (!config_.simulation.sort_particles || (distributed() && !node_halo_) ||
+  // (WLS bodies in contact keep their order: each field's integrator colours a copy of its
+  // particles, wls/fields.hpp.)
+  if (!config_.simulation.sort_particles || (distributed() && !node_halo_) || wls_fields_ ||
       n < (wls_ ? sort_min_particles_wls : sort_min_particles) || particles_.id.size() != n)
     return;
   // A WLS run colours its particles in the integrator's own cache (wls/integrator.cpp).

@@ -34,6 +34,8 @@ namespace cairn {
 namespace wls {
 template <int D>
 class Integrator;
+template <int D>
+class Fields;
 }
 struct StressTiming;
 
@@ -132,6 +134,9 @@ class Simulation {
   /// The WLS method's state (method.integration = "wls", docs/wls.md), or null.
   [[nodiscard]] const wls::Integrator<D>* wls() const { return wls_.get(); }
   [[nodiscard]] wls::Integrator<D>* wls() { return wls_.get(); }
+  /// WLS bodies in contact (docs/wls.md, "Contact"): one integrator per contact field, wls()
+  /// being field 0's; null without [contact].
+  [[nodiscard]] const wls::Fields<D>* wls_fields() const { return wls_fields_.get(); }
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
   [[nodiscard]] Contact<D>* contact() { return contact_.get(); }
@@ -345,6 +350,7 @@ class Simulation {
   double small_mass_ = 0.0;
   std::unique_ptr<Contact<D>> contact_;      ///< multimaterial mode ([contact] mode != none)
   std::unique_ptr<wls::Integrator<D>> wls_;  ///< method.integration = "wls"
+  std::unique_ptr<wls::Fields<D>> wls_fields_;  ///< WLS with [contact]: the fields' integrators
   int n_fields_ = 1;
   std::vector<Vec<D>> contact_dv_;           ///< dv^a of the first correction (slots)
   std::vector<Vec<D>> contact_impulse_;      ///< its non-bonded part, an impulse on the particles (slots)

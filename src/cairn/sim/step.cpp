@@ -22,6 +22,7 @@
 #include "cairn/sim/resources.hpp"
 #include "cairn/transfer/transfer.hpp"
 #include "cairn/util/failure.hpp"
+#include "cairn/wls/fields.hpp"
 #include "cairn/wls/integrator.hpp"
 #include "cairn/wls/step.hpp"
 
@@ -149,8 +150,15 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
                                   });
     return true;
   }
+  void prepare_contact(double dt) override {
+    // The contact's point clouds and normals read the engine's stencils of every particle (the
+    // linear hat, seed 001's narrow S: sim/simulation.cpp) and their slot offsets; the
+    // after_momentum hook is the contact's: nodes, normals, the first correction, the totals.
+    sim_.build_stencils();
+    sim_.run_hooks(StepPoint::after_momentum, dt);
+  }
   void prepare_conditions(double dt) override {
-    sim_.velocity_conditions_.prepare(sim_.grid_, sim_.nodes_, sim_.small_mass_, sim_.time_, dt);
+    sim_.velocity_conditions_.prepare(sim_.grid_, sim_.condition_fields(), sim_.small_mass_, sim_.time_, dt);
   }
   void update_grid(double dt) override { sim_.update_grid(dt); }
   void impose_end_conditions() override {
@@ -194,7 +202,10 @@ void Simulation<D>::wls_step(double dt) {
   step_dt_ = dt;
   keep_particles_sorted(false);  // by the last step's colouring (before its stencils are rebuilt)
   WlsStages stages(*this);
-  wls::step(*wls_, stages, grid_, particles_, nodes_, material_density_, dt);
+  if (wls_fields_)
+    wls::step_fields(*wls_fields_, stages, grid_, particles_, field_offset_, nodes_, material_density_, dt);
+  else
+    wls::step(*wls_, stages, grid_, particles_, nodes_, material_density_, dt);
   velocity_conditions_.finish_step();
   time_ += dt;
   ++step_;
@@ -443,8 +454,11 @@ void Simulation<D>::update_grid(double dt) {
       nodes_.velocity_new[i] = (nodes_.momentum[i] + f_scale * nodes_.force[i] * dt) / m;
     } else if (wls_) {
       // WLS: the grid velocity is the least-squares fit wherever particles see the node, mass
-      // or not (seed 001 Sec. 4.6); without mass there is no acceleration.
-      nodes_.velocity[i] = nodes_.velocity_new[i] = wls_->node_velocity()[i];
+      // or not (seed 001 Sec. 4.6); without mass there is no acceleration. With contact, the
+      // fit of the slot's field.
+      const std::int32_t nn = grid_.n_nodes();
+      nodes_.velocity[i] = nodes_.velocity_new[i] =
+          wls_fields_ ? wls_fields_->node_velocity(i / nn, i % nn) : wls_->node_velocity()[i];
     } else {
       nodes_.velocity[i].setZero();
       nodes_.velocity_new[i].setZero();

@@ -33,11 +33,41 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
   engine.lap(5);
 }
 
+template <int D>
+void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
+                 const std::vector<std::int32_t>& field_offset, NodeField<D>& nodes,
+                 const std::vector<double>& density0, double dt) {
+  // Each field's particles on their own (Sec. 4.1-4.5 per field), into the field's slots.
+  const std::vector<Vec<D>>* body = engine.body_accelerations();
+  fields.split(particles, field_offset, grid.n_nodes(), body);
+  engine.lap(0);
+  fields.collect(grid, density0, body != nullptr, nodes, body ? engine.node_body_forces() : nullptr);
+  engine.prepare_contact(dt);  // seed 004: contact nodes, normals, first correction
+  engine.prepare_conditions(dt);
+  engine.lap(1);
+  engine.update_grid(dt);  // Eq. 25-26 per field, the second contact correction, the conditions
+  engine.lap(2);
+  // Eq. 27-29 per field with its own grid velocities.
+  std::vector<std::uint8_t>& held = fields.integrator(0).held_components();
+  engine.held_components(held);
+  fields.move_particles(grid, nodes, particles, dt, &held);
+  engine.lap(4);
+  engine.update_materials(fields.particle_velocity_gradient(), dt);  // Eq. 30
+  engine.lap(5);
+}
+
 template void step<1>(Integrator<1>&, EngineStages<1>&, const Grid<1>&, Particles<1>&, NodeField<1>&,
                       const std::vector<double>&, double);
 template void step<2>(Integrator<2>&, EngineStages<2>&, const Grid<2>&, Particles<2>&, NodeField<2>&,
                       const std::vector<double>&, double);
 template void step<3>(Integrator<3>&, EngineStages<3>&, const Grid<3>&, Particles<3>&, NodeField<3>&,
                       const std::vector<double>&, double);
+
+template void step_fields<1>(Fields<1>&, EngineStages<1>&, const Grid<1>&, Particles<1>&,
+                             const std::vector<std::int32_t>&, NodeField<1>&, const std::vector<double>&, double);
+template void step_fields<2>(Fields<2>&, EngineStages<2>&, const Grid<2>&, Particles<2>&,
+                             const std::vector<std::int32_t>&, NodeField<2>&, const std::vector<double>&, double);
+template void step_fields<3>(Fields<3>&, EngineStages<3>&, const Grid<3>&, Particles<3>&,
+                             const std::vector<std::int32_t>&, NodeField<3>&, const std::vector<double>&, double);
 
 }  // namespace cairn::wls

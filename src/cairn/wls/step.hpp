@@ -10,6 +10,7 @@
 
 #include "cairn/grid/grid.hpp"
 #include "cairn/particles/particles.hpp"
+#include "cairn/wls/fields.hpp"
 #include "cairn/wls/integrator.hpp"
 
 namespace cairn::wls {
@@ -25,6 +26,10 @@ class EngineStages {
   virtual std::vector<Vec<D>>* node_body_forces() = 0;
   /// Fill `loads` with the surface loads (tractions) at t + dt/2; false: none.
   virtual bool surface_loads(double dt, SurfaceLoads<D>& loads) = 0;
+  /// Multimaterial mode (step_fields): the contact nodes, normals and separations of this step
+  /// from the collected fields and the first correction of their momenta (seed 004 Eq. 26);
+  /// the second one comes with update_grid (Eq. 30-34).
+  virtual void prepare_contact(double dt) = 0;
   /// The velocity conditions of this step, from the collected node masses.
   virtual void prepare_conditions(double dt) = 0;
   /// Eq. 25-26: v+ = v + a dt with the velocity conditions (half the first acceleration, Sec. 4.7).
@@ -46,5 +51,14 @@ class EngineStages {
 template <int D>
 void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
           NodeField<D>& nodes, const std::vector<double>& density0, double dt);
+
+/// One step of length dt of WLS bodies in contact (wls/fields.hpp): every field's collection into
+/// its slots of `nodes`, the engine's contact and grid update on the slots, every field's
+/// particle move. Options that change the node fields after the grid update (the acceleration
+/// filter, hourglass damping, XPIC) are not defined here (the engine refuses them).
+template <int D>
+void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
+                 const std::vector<std::int32_t>& field_offset, NodeField<D>& nodes,
+                 const std::vector<double>& density0, double dt);
 
 }  // namespace cairn::wls

@@ -1,0 +1,78 @@
+// WLS bodies in contact (docs/wls.md, "Contact"): the multimaterial mode of seed 004 on the WLS
+// method of seed 001. Each contact field (a material or a body, [contact] mode) is its own WLS
+// body: its particles alone give its node fits, signed distance and cut cells (Sec. 3-4), hence
+// its node mass, least-squares momentum and forces (Eq. 22-24), which go into the field's slots
+// of the engine's node arrays (slot = field * n_nodes + node, contact/contact.hpp). The engine's
+// contact corrects those fields as it corrects MPM's, and each field's particles then move with
+// their own field's grid velocities (Eq. 27-29).
+//
+// Fields keeps one Integrator per field and, each step, a copy of each field's particles: the
+// Integrator's passes then run unchanged on a field. The copies cost a pass over the particles'
+// arrays per step; contact runs are small next to that.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "cairn/grid/grid.hpp"
+#include "cairn/particles/particles.hpp"
+#include "cairn/wls/integrator.hpp"
+
+namespace cairn::wls {
+
+template <int D>
+class Fields {
+ public:
+  /// n_fields integrators with `options`; `first` (not null) is field 0's, owned by the caller
+  /// (the engine's Simulation::wls(), which its outputs and diagnostics read).
+  Fields(const Grid<D>& grid, const Options& options, int n_fields, Integrator<D>* first);
+
+  [[nodiscard]] int n() const { return static_cast<int>(integrators_.size()); }
+  [[nodiscard]] Integrator<D>& integrator(int f) { return *integrators_[static_cast<std::size_t>(f)]; }
+  [[nodiscard]] const Integrator<D>& integrator(int f) const { return *integrators_[static_cast<std::size_t>(f)]; }
+  /// Field f's particles, as of the last split (moved by the last step).
+  [[nodiscard]] Particles<D>& particles(int f) { return particles_[static_cast<std::size_t>(f)]; }
+  /// Field f's least-squares velocity at node i (Eq. 11) of the last collect: the engine's grid
+  /// velocity at a slot without mass (seed 001 Sec. 4.6).
+  [[nodiscard]] const Vec<D>& node_velocity(int f, std::int32_t i) const {
+    return integrator(f).node_velocity()[static_cast<std::size_t>(i)];
+  }
+
+  /// Copy each field's particles into its own Particles, in the order they are stored, and the
+  /// body accelerations with them (null: none). Particle p's field is field_offset[p] / n_nodes
+  /// (the engine's slot offsets, contact/contact.hpp).
+  void split(const Particles<D>& particles, const std::vector<std::int32_t>& field_offset, std::int32_t n_nodes,
+             const std::vector<Vec<D>>* body_acceleration);
+  /// Sec. 4.1-4.5 for every field: build its stencils, collect its node mass, momentum and
+  /// force into its slots of `nodes` (sized n() * n_nodes) and, when given, the external part of
+  /// the force into its slots of `node_body_force`.
+  void collect(const Grid<D>& grid, const std::vector<double>& density0, bool body_force, NodeField<D>& nodes,
+               std::vector<Vec<D>>* node_body_force);
+  /// Eq. 27-29 for every field from its slots of nodes.velocity and nodes.velocity_new; the
+  /// moved positions and velocities go back into `particles` and each particle's velocity
+  /// gradient into particle_velocity_gradient(). `held` as for Integrator::move_particles.
+  void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
+                      const std::vector<std::uint8_t>* held);
+  /// grad V_p of every particle (the whole set's order) from the last move_particles.
+  [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
+    return gradient_;
+  }
+
+ private:
+  std::vector<std::unique_ptr<Integrator<D>>> owned_;  ///< the integrators of fields 1..n-1
+  std::vector<Integrator<D>*> integrators_;
+  std::vector<Particles<D>> particles_;                 ///< per field: a copy of its particles
+  std::vector<std::vector<std::int32_t>> index_;        ///< per field: their indices in the whole set
+  std::vector<std::vector<Vec<D>>> body_;               ///< per field: their body accelerations
+  NodeField<D> scratch_;                                ///< one field's node values
+  std::vector<Vec<D>> scratch_body_;
+  std::vector<Eigen::Matrix<double, D, D>> gradient_;
+};
+
+/// The integration regions of every field as points for a snapshot (region_points, fields one
+/// after the other).
+template <int D>
+Particles<D> region_points(const Fields<D>& fields);
+
+}  // namespace cairn::wls
