@@ -92,6 +92,8 @@ class Tractions {
   void for_each_face(const Particles<D>& particles, double t,
                      const std::function<void(std::int32_t, const Vec<D>&, const Vec<D>&, const Vec<D>&)>& fn);
   [[nodiscard]] std::size_t n_loads() const { return loads_.size(); }
+  /// The particle (local index) of the q-th face for_each_face visits.
+  [[nodiscard]] std::int32_t face_particle(std::size_t q) const { return faces_[q].particle; }
   /// sum_i f_i^(T) . v_i for the forces of the last add_forces (work rate at grid velocity v),
   /// over the faces of owned particles, summed exactly (the caller adds the ranks).
   [[nodiscard]] ExactSum power(const std::vector<Vec<D>>& v,

@@ -286,8 +286,7 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
       // WLS bodies in contact (wls/fields.hpp): what acts on one node field after the grid
       // update, or on the particles through the first correction, is defined for one field
       // only (docs/wls.md, "Contact").
-      const char* alone = !config_.tractions.empty()                  ? "[[traction]]"
-                          : o.filter_acceleration                     ? "method.filter_acceleration"
+      const char* alone = o.filter_acceleration                       ? "method.filter_acceleration"
                           : o.hourglass_damping > 0.0                 ? "method.hourglass_damping"
                           : o.xpic_order > 0                          ? "method.particle_velocity = \"xpic\""
                           : o.energy_budget                           ? "method.energy_budget"

@@ -134,20 +134,26 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     return sim_.body_force_.empty() ? nullptr : &sim_.body_acceleration_;
   }
   std::vector<Vec<D>>* node_body_forces() override { return &sim_.node_body_force_; }
-  bool surface_loads(double dt, wls::SurfaceLoads<D>& loads) override {
+  bool surface_loads(double dt, const std::vector<wls::SurfaceLoads<D>*>& loads) override {
     if (sim_.tractions_.empty()) return false;
     // The tractions' faces convected by F (bc/traction.hpp); the integrator spreads their forces
-    // over the cut-cell surface (wls/integrator.cpp, spread_surface_loads).
-    loads.reset(2 * D * sim_.tractions_.n_loads());
-    sim_.tractions_.for_each_face(sim_.particles_, sim_.time_ + 0.5 * dt,
-                                  [&](std::int32_t g, const Vec<D>& centre, const Vec<D>& normal_area,
-                                      const Vec<D>& force) {
-                                    loads.centre.push_back(centre);
-                                    loads.face_force.push_back(force);
-                                    loads.group.push_back(g);
-                                    loads.force[g] += force;
-                                    loads.normal[g] += normal_area;
-                                  });
+    // over the cut-cell surface (wls/integrator.cpp, spread_surface_loads). With one SurfaceLoads
+    // per contact field, a face goes to its particle's field.
+    for (wls::SurfaceLoads<D>* l : loads) l->reset(2 * D * sim_.tractions_.n_loads());
+    const std::int32_t nn = sim_.grid_.n_nodes();
+    std::size_t q = 0;  // (for_each_face visits the faces in order)
+    sim_.tractions_.for_each_face(
+        sim_.particles_, sim_.time_ + 0.5 * dt,
+        [&](std::int32_t g, const Vec<D>& centre, const Vec<D>& normal_area, const Vec<D>& force) {
+          const auto p = static_cast<std::size_t>(sim_.tractions_.face_particle(q++));
+          const std::size_t field = loads.size() == 1 ? 0 : static_cast<std::size_t>(sim_.field_offset_[p] / nn);
+          wls::SurfaceLoads<D>& to = *loads[field];
+          to.centre.push_back(centre);
+          to.face_force.push_back(force);
+          to.group.push_back(g);
+          to.force[g] += force;
+          to.normal[g] += normal_area;
+        });
     return true;
   }
   void prepare_contact(double dt) override {
@@ -478,11 +484,16 @@ void Simulation<D>::update_grid(double dt) {
   const bool has_body_force = !body_force_.empty();
   std::array<ExactSum, 3> work;
   if (!tractions_.empty() && wls_) {
-    // (WLS: the node forces of the tractions are the integrator's, wls/integrator.cpp)
-    const auto& f = wls_->surface_force();
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      work[0].add(f[i].dot(nodes_.velocity[i]));
-      work[1].add(f[i].dot(nodes_.velocity_new[i]));
+    // (WLS: the node forces of the tractions are the integrator's, wls/integrator.cpp; with
+    // contact each field's, on its slots)
+    const int n_integrators = wls_fields_ ? wls_fields_->n() : 1;
+    for (int k = 0; k < n_integrators; ++k) {
+      const auto& f = (wls_fields_ ? wls_fields_->integrator(k) : *wls_).surface_force();
+      const std::size_t off = static_cast<std::size_t>(k) * static_cast<std::size_t>(grid_.n_nodes());
+      for (std::size_t i = 0; i < f.size(); ++i) {
+        work[0].add(f[i].dot(nodes_.velocity[off + i]));
+        work[1].add(f[i].dot(nodes_.velocity_new[off + i]));
+      }
     }
   } else if (!tractions_.empty()) {
     work[0] = tractions_.power(nodes_.velocity, contact_ ? &field_offset_ : nullptr);

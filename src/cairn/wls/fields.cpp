@@ -54,7 +54,7 @@ void Fields<D>::split(const Particles<D>& particles, const std::vector<std::int3
 
 template <int D>
 void Fields<D>::collect(const Grid<D>& grid, const std::vector<double>& density0, bool body_force,
-                        NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force) {
+                        NodeField<D>& nodes, std::vector<Vec<D>>* node_body_force, bool surface_loads) {
   const std::int32_t nn = grid.n_nodes();
   if (body_force) scratch_body_.assign(static_cast<std::size_t>(nn), Vec<D>::Zero());
   for (int f = 0; f < n(); ++f) {
@@ -63,7 +63,7 @@ void Fields<D>::collect(const Grid<D>& grid, const std::vector<double>& density0
     const Particles<D>& sub = particles_[static_cast<std::size_t>(f)];
     wls.build_stencils(grid, sub);
     wls.collect(grid, sub, density0, body_force ? &body_[static_cast<std::size_t>(f)] : nullptr, scratch_,
-                body_force ? &scratch_body_ : nullptr);
+                body_force ? &scratch_body_ : nullptr, surface_loads && !wls.surface_loads().centre.empty());
     for_each_node(nn, [&](std::int32_t i) {
       const std::size_t s = off + static_cast<std::size_t>(i);
       nodes.mass[s] = scratch_.mass[i];

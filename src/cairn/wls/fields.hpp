@@ -46,9 +46,10 @@ class Fields {
              const std::vector<Vec<D>>* body_acceleration);
   /// Sec. 4.1-4.5 for every field: build its stencils, collect its node mass, momentum and
   /// force into its slots of `nodes` (sized n() * n_nodes) and, when given, the external part of
-  /// the force into its slots of `node_body_force`.
+  /// the force into its slots of `node_body_force`. With `surface_loads`, each field's integrator
+  /// spreads the loads its Integrator::surface_loads() holds (its own faces).
   void collect(const Grid<D>& grid, const std::vector<double>& density0, bool body_force, NodeField<D>& nodes,
-               std::vector<Vec<D>>* node_body_force);
+               std::vector<Vec<D>>* node_body_force, bool surface_loads = false);
   /// Eq. 27-29 for every field from its slots of nodes.velocity and nodes.velocity_new; the
   /// moved positions and velocities go back into `particles` and each particle's velocity
   /// gradient into particle_velocity_gradient(). `held` as for Integrator::move_particles.

@@ -24,8 +24,9 @@ class EngineStages {
   /// S^T M b part of the node forces goes.
   virtual const std::vector<Vec<D>>* body_accelerations() = 0;
   virtual std::vector<Vec<D>>* node_body_forces() = 0;
-  /// Fill `loads` with the surface loads (tractions) at t + dt/2; false: none.
-  virtual bool surface_loads(double dt, SurfaceLoads<D>& loads) = 0;
+  /// Fill `loads` with the surface loads (tractions) at t + dt/2: one SurfaceLoads for all
+  /// particles, or (step_fields) one per contact field, each with its field's faces; false: none.
+  virtual bool surface_loads(double dt, const std::vector<SurfaceLoads<D>*>& loads) = 0;
   /// Multimaterial mode (step_fields): the contact nodes, normals and separations of this step
   /// from the collected fields and the first correction of their momenta (seed 004 Eq. 26);
   /// the second one comes with update_grid (Eq. 30-34).
@@ -54,8 +55,9 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
 
 /// One step of length dt of WLS bodies in contact (wls/fields.hpp): every field's collection into
 /// its slots of `nodes`, the engine's contact and grid update on the slots, every field's
-/// particle move. Options that change the node fields after the grid update (the acceleration
-/// filter, hourglass damping, XPIC) are not defined here (the engine refuses them).
+/// particle move; each field spreads the tractions on its own faces. Options that change the
+/// node fields after the grid update (the acceleration filter, hourglass damping, XPIC) are not
+/// defined here (the engine refuses them).
 template <int D>
 void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
                  const std::vector<std::int32_t>& field_offset, NodeField<D>& nodes,
