@@ -166,10 +166,11 @@ TEST(RunLoop, ContactReleasedBySeparationRestartsBitIdentical) {
 
 TEST(RunLoop, WlsContactRestartsBitIdentical) {
   // WLS bodies in contact (docs/wls.md, "Contact"): each field's integrator rebuilds everything
-  // from the particles every step, so the particles and the contact record are all a restart
-  // from the middle of the impact needs.
+  // from the particles every step, so the particles, the contact record and the energy budget's
+  // totals are all a restart from the middle of the impact needs.
   expect_bit_identical_restart("wls_contact",
-                               {"method.integration=\"wls\"", "method.time_integration=\"central_difference\""},
+                               {"method.integration=\"wls\"", "method.time_integration=\"central_difference\"",
+                                "method.energy_budget=true"},
                                contact_disks);
 }
 

@@ -244,12 +244,12 @@ class MpmEngine final : public Engine {
     auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w)
       walls[w].set_position(data.scalars.at(fmt::format("wall_position_{}", w)));
-    if (auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {  // absent from checkpoints of runs without it: 0
+    if (has_energy_budget(sim_)) {  // absent from checkpoints of runs without it: 0
       const auto scalar = [&](const char* key) {
         const auto it = data.scalars.find(key);
         return it == data.scalars.end() ? 0.0 : it->second;
       };
-      w->restore_energy_budget(scalar("wls_grid_work"), scalar("wls_transfer_energy"));
+      sim_.restore_wls_energy_budget(scalar("wls_grid_work"), scalar("wls_transfer_energy"));
     }
     initial_energy_ = data.scalars.at("initial_energy");
     if (!exact_.empty()) error_max_ = data.scalars.at("displacement_error_max");
@@ -424,9 +424,9 @@ class MpmEngine final : public Engine {
     const auto& walls = sim_.velocity_conditions().walls();
     for (std::size_t w = 0; w < walls.size(); ++w) data.scalars[fmt::format("wall_position_{}", w)] = walls[w].position();
     if (!exact_.empty()) data.scalars["displacement_error_max"] = error_max_;
-    if (const auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {
-      data.scalars["wls_grid_work"] = w->grid_work();
-      data.scalars["wls_transfer_energy"] = w->transfer_energy();
+    if (has_energy_budget(sim_)) {
+      data.scalars["wls_grid_work"] = sim_.wls_grid_work();
+      data.scalars["wls_transfer_energy"] = sim_.wls_transfer_energy();
     }
     data.history_columns = history_writer_.columns();
     data.history_rows = history_writer_.rows();
@@ -509,9 +509,9 @@ class MpmEngine final : public Engine {
       row.push_back(error_now_);
       row.push_back(error_max_);
     }
-    if (const auto* w = has_energy_budget(sim_) ? sim_.wls() : nullptr) {
-      row.push_back(w->grid_work());
-      row.push_back(w->transfer_energy());
+    if (has_energy_budget(sim_)) {
+      row.push_back(sim_.wls_grid_work());
+      row.push_back(sim_.wls_transfer_energy());
     }
     if (const auto* c = sim_.contact()) {
       row.push_back(static_cast<double>(c->contact_nodes()));

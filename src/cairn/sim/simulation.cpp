@@ -283,18 +283,11 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
     }
     o.thickness = config_.simulation.thickness;
     if (contact_) {
-      // WLS bodies in contact (wls/fields.hpp): what acts on one node field after the grid
-      // update, or on the particles through the first correction, is defined for one field
-      // only (docs/wls.md, "Contact").
-      const char* alone = o.filter_acceleration                       ? "method.filter_acceleration"
-                          : o.hourglass_damping > 0.0                 ? "method.hourglass_damping"
-                          : o.xpic_order > 0                          ? "method.particle_velocity = \"xpic\""
-                          : o.energy_budget                           ? "method.energy_budget"
-                          : config_.contact.first_correction == "impulse" ? "contact.first_correction = \"impulse\""
-                                                                      : nullptr;
-      if (alone)
-        throw std::invalid_argument(std::string("method.integration = \"wls\" with [contact] does not support ") +
-                                    alone + " (docs/wls.md, \"Contact\")");
+      // WLS bodies in contact (wls/fields.hpp): the first correction's impulse reaches the
+      // particles through the MPM particle update, which WLS replaces (docs/wls.md, "Contact").
+      if (config_.contact.first_correction == "impulse")
+        throw std::invalid_argument("method.integration = \"wls\" with [contact] does not support "
+                                    "contact.first_correction = \"impulse\" (docs/wls.md, \"Contact\")");
     }
     wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
     if (contact_) wls_fields_ = std::make_unique<wls::Fields<D>>(grid_, o, contact_->n_fields(), wls_.get());
@@ -400,6 +393,22 @@ SimulationFailure Simulation<D>::named_by_id(const SimulationFailure& f) const {
       message.replace(at, local.size(), "particle " + std::to_string(id));
   }
   return {id, f.quantity(), message};
+}
+
+template <int D>
+double Simulation<D>::wls_grid_work() const {
+  return wls_fields_ ? wls_fields_->grid_work() : wls_ ? wls_->grid_work() : 0.0;
+}
+
+template <int D>
+double Simulation<D>::wls_transfer_energy() const {
+  return wls_fields_ ? wls_fields_->transfer_energy() : wls_ ? wls_->transfer_energy() : 0.0;
+}
+
+template <int D>
+void Simulation<D>::restore_wls_energy_budget(double grid_work, double transfer_energy) {
+  if (wls_fields_) wls_fields_->restore_energy_budget(grid_work, transfer_energy);
+  else if (wls_) wls_->restore_energy_budget(grid_work, transfer_energy);
 }
 
 template <int D>

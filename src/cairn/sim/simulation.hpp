@@ -137,6 +137,10 @@ class Simulation {
   /// WLS bodies in contact (docs/wls.md, "Contact"): one integrator per contact field, wls()
   /// being field 0's; null without [contact].
   [[nodiscard]] const wls::Fields<D>* wls_fields() const { return wls_fields_.get(); }
+  /// The WLS energy budget's sums (docs/wls.md, "Energy budget"), over every contact field.
+  [[nodiscard]] double wls_grid_work() const;
+  [[nodiscard]] double wls_transfer_energy() const;
+  void restore_wls_energy_budget(double grid_work, double transfer_energy);
   /// Multimaterial contact ([contact] mode), or null in single-field mode.
   [[nodiscard]] const Contact<D>* contact() const { return contact_.get(); }
   [[nodiscard]] Contact<D>* contact() { return contact_.get(); }

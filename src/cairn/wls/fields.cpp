@@ -80,6 +80,7 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
                                const std::vector<std::uint8_t>* held) {
   const std::int32_t nn = grid.n_nodes();
   gradient_.resize(particles.n());
+  double grid_work = 0.0, transfer_energy = 0.0;  // this step's (method.energy_budget)
   for (int f = 0; f < n(); ++f) {
     const auto off = static_cast<std::size_t>(f) * static_cast<std::size_t>(nn);
     for_each_node(nn, [&](std::int32_t i) {
@@ -90,7 +91,10 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
     });
     Particles<D>& sub = particles_[static_cast<std::size_t>(f)];
     Integrator<D>& wls = integrator(f);
+    wls.restore_energy_budget(0.0, 0.0);
     wls.move_particles(grid, scratch_, sub, dt, held);
+    grid_work += wls.grid_work();
+    transfer_energy += wls.transfer_energy();
     const std::vector<std::int32_t>& idx = index_[static_cast<std::size_t>(f)];
     for (std::size_t q = 0; q < idx.size(); ++q) {
       const auto p = static_cast<std::size_t>(idx[q]);
@@ -99,6 +103,8 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
       gradient_[p] = wls.particle_velocity_gradient()[q];
     }
   }
+  grid_work_ += grid_work;
+  transfer_energy_ += transfer_energy;
 }
 
 template <int D>

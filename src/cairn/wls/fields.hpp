@@ -55,6 +55,33 @@ class Fields {
   /// gradient into particle_velocity_gradient(). `held` as for Integrator::move_particles.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
                       const std::vector<std::uint8_t>* held);
+  /// fn(integrator, node field) for every field, with the field's slots of nodes.mass,
+  /// velocity and velocity_new in the node field; `write` copies its velocity_new back into the
+  /// slots (the acceleration filter, hourglass damping), otherwise fn only reads (XPIC).
+  template <class Fn>
+  void for_each_field(NodeField<D>& nodes, std::int32_t n_nodes, bool write, Fn&& fn) {
+    for (int f = 0; f < n(); ++f) {
+      const auto off = static_cast<std::size_t>(f) * static_cast<std::size_t>(n_nodes);
+      for (std::int32_t i = 0; i < n_nodes; ++i) {
+        scratch_.mass[i] = nodes.mass[off + i];
+        scratch_.velocity[i] = nodes.velocity[off + i];
+        scratch_.velocity_new[i] = nodes.velocity_new[off + i];
+      }
+      fn(integrator(f), scratch_);
+      if (write)
+        for (std::int32_t i = 0; i < n_nodes; ++i) nodes.velocity_new[off + i] = scratch_.velocity_new[i];
+    }
+  }
+  /// The energy budget's sums (Integrator::grid_work, transfer_energy) over the fields and the
+  /// steps: each step adds every field's sums of that step, so that the totals are the only
+  /// state and a restart continues them bit for bit.
+  [[nodiscard]] double grid_work() const { return grid_work_; }
+  [[nodiscard]] double transfer_energy() const { return transfer_energy_; }
+  /// Both sums from a checkpoint.
+  void restore_energy_budget(double grid_work, double transfer_energy) {
+    grid_work_ = grid_work;
+    transfer_energy_ = transfer_energy;
+  }
   /// grad V_p of every particle (the whole set's order) from the last move_particles.
   [[nodiscard]] const std::vector<Eigen::Matrix<double, D, D>>& particle_velocity_gradient() const {
     return gradient_;
@@ -69,6 +96,7 @@ class Fields {
   NodeField<D> scratch_;                                ///< one field's node values
   std::vector<Vec<D>> scratch_body_;
   std::vector<Eigen::Matrix<double, D, D>> gradient_;
+  double grid_work_ = 0.0, transfer_energy_ = 0.0;
 };
 
 /// The integration regions of every field as points for a snapshot (region_points, fields one

@@ -49,6 +49,20 @@ void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid
   engine.prepare_conditions(dt);
   engine.lap(1);
   engine.update_grid(dt);  // Eq. 25-26 per field, the second contact correction, the conditions
+  // The options that act on the node velocities, each field's on its own (as in step above).
+  const Options& o = fields.integrator(0).options();
+  const std::int32_t nn = grid.n_nodes();
+  if (o.filter_acceleration) {
+    fields.for_each_field(nodes, nn, true, [&](Integrator<D>& wls, NodeField<D>& f) { wls.filter_acceleration(grid, f); });
+    engine.impose_end_conditions();
+  }
+  if (o.hourglass_damping > 0.0) {
+    fields.for_each_field(nodes, nn, true, [&](Integrator<D>& wls, NodeField<D>& f) { wls.damp_hourglass(grid, f); });
+    engine.impose_end_conditions();
+  }
+  if (o.xpic_order > 0)  // particle_velocity = "xpic": each field's particles' start
+    fields.for_each_field(nodes, nn, false,
+                          [&](Integrator<D>& wls, NodeField<D>& f) { wls.xpic_projection(grid, f.mass, f.velocity); });
   engine.lap(2);
   // Eq. 27-29 per field with its own grid velocities.
   std::vector<std::uint8_t>& held = fields.integrator(0).held_components();

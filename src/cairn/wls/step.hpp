@@ -55,9 +55,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
 
 /// One step of length dt of WLS bodies in contact (wls/fields.hpp): every field's collection into
 /// its slots of `nodes`, the engine's contact and grid update on the slots, every field's
-/// particle move; each field spreads the tractions on its own faces. Options that change the
-/// node fields after the grid update (the acceleration filter, hourglass damping, XPIC) are not
-/// defined here (the engine refuses them).
+/// particle move; each field spreads the tractions on its own faces, and the acceleration filter,
+/// hourglass damping and XPIC act on each field's node values.
 template <int D>
 void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid, Particles<D>& particles,
                  const std::vector<std::int32_t>& field_offset, NodeField<D>& nodes,
