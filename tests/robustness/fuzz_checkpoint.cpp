@@ -9,7 +9,8 @@
 // mutations, mostly refused by the content checksum or by HDF5 itself), or a program of
 // structured mutations applied with the HDF5 C API to one of the seed checkpoints (real files
 // written by small runs: MPM in 1D, 2D with contact and state variables, 3D APIC with
-// temperature, WLS, a run on 2 MPI ranks, the FEM; tests/robustness/corpus/checkpoint/seeds):
+// temperature, WLS, WLS bodies in contact, a run on 2 MPI ranks, the FEM;
+// tests/robustness/corpus/checkpoint/seeds):
 //
 //   byte 0: the seed; byte 1: the checksum afterwards (recomputed, so that the reader's own checks
 //   are reached; left stale; deleted); then 8-byte operations [op, a, b, c, d0..d3]: delete a

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Write the seed checkpoints of cairn_fuzz_checkpoint (tests/robustness/fuzz_checkpoint.cpp) from
 # the inputs in inputs/: each run stops after 3 steps and leaves its checkpoint (MPM 1D; 2D with
-# contact, a wall and state variables; 3D APIC with temperatures; WLS; FEM; and the 2D contact
-# case on 2 MPI ranks, whose particles are stored rank after rank).
+# contact, a wall and state variables; 3D APIC with temperatures; WLS; WLS bodies in contact; FEM;
+# and the 2D contact case on 2 MPI ranks, whose particles are stored rank after rank).
 # Usage, from the repository root: tests/robustness/corpus/checkpoint/make_seeds.sh [build/release/cairn]
 set -euo pipefail
 cairn="$(realpath "${1:-build/release/cairn}")"
@@ -10,7 +10,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 cd "$work"
-for input in mpm_1d mpm_2d_contact mpm_3d_apic_thermal wls_2d fem_2d; do
+for input in mpm_1d mpm_2d_contact mpm_3d_apic_thermal wls_2d wls_2d_contact fem_2d; do
   "$cairn" run -q -t 1 "$here/inputs/$input.toml" --set simulation.max_steps=3 --set output.directory="\"$work/$input\""
   cp "$work/$input"/checkpoint-0000.h5 "$here/seeds/$input.h5"
 done
