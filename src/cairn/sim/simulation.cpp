@@ -282,13 +282,6 @@ Simulation<D>::Simulation(const Config& config, const Comm& comm) : config_(conf
         o.mirror[f] = std::abs(particles_.position[p][a] - plane) < 0.5 * grid_.cell_size()[a];
     }
     o.thickness = config_.simulation.thickness;
-    if (contact_) {
-      // WLS bodies in contact (wls/fields.hpp): the first correction's impulse reaches the
-      // particles through the MPM particle update, which WLS replaces (docs/wls.md, "Contact").
-      if (config_.contact.first_correction == "impulse")
-        throw std::invalid_argument("method.integration = \"wls\" with [contact] does not support "
-                                    "contact.first_correction = \"impulse\" (docs/wls.md, \"Contact\")");
-    }
     wls_ = std::make_unique<wls::Integrator<D>>(grid_, o);
     if (contact_) wls_fields_ = std::make_unique<wls::Fields<D>>(grid_, o, contact_->n_fields(), wls_.get());
   }

@@ -163,6 +163,10 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     sim_.build_stencils();
     sim_.run_hooks(StepPoint::after_momentum, dt);
   }
+  const std::vector<Vec<D>>* contact_impulse() override {
+    const Contact<D>* c = sim_.contact_.get();
+    return c && c->impulse() && c->corrects_extrapolation() ? &sim_.contact_impulse_ : nullptr;
+  }
   void prepare_conditions(double dt) override {
     sim_.velocity_conditions_.prepare(sim_.grid_, sim_.condition_fields(), sim_.small_mass_, sim_.time_, dt);
   }

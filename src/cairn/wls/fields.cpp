@@ -77,7 +77,7 @@ void Fields<D>::collect(const Grid<D>& grid, const std::vector<double>& density0
 
 template <int D>
 void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
-                               const std::vector<std::uint8_t>* held) {
+                               const std::vector<std::uint8_t>* held, const std::vector<Vec<D>>* impulse) {
   const std::int32_t nn = grid.n_nodes();
   gradient_.resize(particles.n());
   double grid_work = 0.0, transfer_energy = 0.0;  // this step's (method.energy_budget)
@@ -89,10 +89,12 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
       scratch_.velocity[i] = nodes.velocity[s];
       scratch_.velocity_new[i] = nodes.velocity_new[s];
     });
+    if (impulse) scratch_impulse_.assign(impulse->begin() + static_cast<std::ptrdiff_t>(off),
+                                         impulse->begin() + static_cast<std::ptrdiff_t>(off + static_cast<std::size_t>(nn)));
     Particles<D>& sub = particles_[static_cast<std::size_t>(f)];
     Integrator<D>& wls = integrator(f);
     wls.restore_energy_budget(0.0, 0.0);
-    wls.move_particles(grid, scratch_, sub, dt, held);
+    wls.move_particles(grid, scratch_, sub, dt, held, impulse ? &scratch_impulse_ : nullptr);
     grid_work += wls.grid_work();
     transfer_energy += wls.transfer_energy();
     const std::vector<std::int32_t>& idx = index_[static_cast<std::size_t>(f)];

@@ -52,9 +52,10 @@ class Fields {
                std::vector<Vec<D>>* node_body_force, bool surface_loads = false);
   /// Eq. 27-29 for every field from its slots of nodes.velocity and nodes.velocity_new; the
   /// moved positions and velocities go back into `particles` and each particle's velocity
-  /// gradient into particle_velocity_gradient(). `held` as for Integrator::move_particles.
+  /// gradient into particle_velocity_gradient(). `held` as for Integrator::move_particles;
+  /// `impulse` (slots, or null) the contact's first correction as an impulse on the particles.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
-                      const std::vector<std::uint8_t>* held);
+                      const std::vector<std::uint8_t>* held, const std::vector<Vec<D>>* impulse = nullptr);
   /// fn(integrator, node field) for every field, with the field's slots of nodes.mass,
   /// velocity and velocity_new in the node field; `write` copies its velocity_new back into the
   /// slots (the acceleration filter, hourglass damping), otherwise fn only reads (XPIC).
@@ -95,6 +96,7 @@ class Fields {
   std::vector<std::vector<Vec<D>>> body_;               ///< per field: their body accelerations
   NodeField<D> scratch_;                                ///< one field's node values
   std::vector<Vec<D>> scratch_body_;
+  std::vector<Vec<D>> scratch_impulse_;
   std::vector<Eigen::Matrix<double, D, D>> gradient_;
   double grid_work_ = 0.0, transfer_energy_ = 0.0;
 };

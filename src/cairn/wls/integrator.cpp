@@ -552,7 +552,8 @@ void Integrator<D>::integrate(const Grid<D>& grid, bool body_force, NodeField<D>
 
 template <int D>
 void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles,
-                                   double dt, const std::vector<std::uint8_t>* held) {
+                                   double dt, const std::vector<std::uint8_t>* held,
+                                   const std::vector<Vec<D>>* impulse) {
   const auto& v = nodes.velocity;
   const auto& v_new = nodes.velocity_new;
   const auto& mass = nodes.mass;
@@ -571,7 +572,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
     const std::size_t q = static_cast<std::size_t>(p) * D * 3;
     const std::int32_t* axis_node = &cache_.axis_node[q];
     const double* axis_S = &cache_.axis_value[2 * q];
-    Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero();
+    Vec<D> dv = Vec<D>::Zero(), vx = Vec<D>::Zero(), kick = Vec<D>::Zero();
     Eigen::Matrix<double, D, D> L = Eigen::Matrix<double, D, D>::Zero();
     // The transpose of the stress transfer (docs/wls.md, departure 17), where its weight is a
     // volume near the particle's own: a massless surface particle stores no power, and where the
@@ -594,6 +595,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
       massless |= S != 0.0 && !(mass[i] > 0.0);
       dv += S * (v_new[i] - v[i]);  // Eq. 27: S a dt
       vx += S * v_new[i];           // Eq. 28
+      if (impulse) kick += S * (*impulse)[i];
       if (!from_quadrature) {
         Vec<D> G = Vec<D>::Ones();  // G_ip,b = prod_a (a == b ? G_a : S_a)
         for (int a = 0; a < D; ++a)
@@ -654,7 +656,7 @@ void Integrator<D>::move_particles(const Grid<D>& grid, const NodeField<D>& node
                          : fitted_surface && is_surface(particles, static_cast<std::size_t>(p))
                              ? fitted_velocity(grid, axis_node, axis_S, particles.position[p], particles.velocity[p])
                              : particles.velocity[p];
-    particles.velocity[p] = pic ? vx : Vec<D>(start + dv);
+    particles.velocity[p] = pic ? vx : impulse ? Vec<D>(start + kick + dv) : Vec<D>(start + dv);
     particles.position[p] += vx * dt;
     particle_gradient_[p] = L;
     return 0.5 * particles.mass[p] * (particles.velocity[p].squaredNorm() - before);

@@ -177,8 +177,11 @@ class Integrator {
   /// (sum v+ (x) G_ip) or, with Options::quadrature_gradient, the S-interpolated node means of the
   /// integration points' gradients. `held` (per node, bit a: a velocity condition set component
   /// a; null: none) keeps the conditions' values at corners without mass (departure 12).
+  /// `impulse` (per node, or null): the contact's first correction as an impulse on the
+  /// particles (contact.first_correction = "impulse", docs/contact.md): V' = V + sum S dv_c,
+  /// from which Eq. 27's increment proceeds.
   void move_particles(const Grid<D>& grid, const NodeField<D>& nodes, Particles<D>& particles, double dt,
-                      const std::vector<std::uint8_t>* held = nullptr);
+                      const std::vector<std::uint8_t>* held = nullptr, const std::vector<Vec<D>>* impulse = nullptr);
 
   /// Kinetic-energy budget of the steps so far (docs/wls.md, "Energy budget"), summed over the
   /// move_particles calls with Options::energy_budget (zero without): grid_work = the grid's kinetic energy change from v to v+ (the work of

@@ -67,7 +67,7 @@ void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid
   // Eq. 27-29 per field with its own grid velocities.
   std::vector<std::uint8_t>& held = fields.integrator(0).held_components();
   engine.held_components(held);
-  fields.move_particles(grid, nodes, particles, dt, &held);
+  fields.move_particles(grid, nodes, particles, dt, &held, engine.contact_impulse());
   engine.lap(4);
   engine.update_materials(fields.particle_velocity_gradient(), dt);  // Eq. 30
   engine.lap(5);

@@ -31,6 +31,9 @@ class EngineStages {
   /// from the collected fields and the first correction of their momenta (seed 004 Eq. 26);
   /// the second one comes with update_grid (Eq. 30-34).
   virtual void prepare_contact(double dt) = 0;
+  /// The contact's first correction as an impulse on the particles (slots; null unless
+  /// contact.first_correction = "impulse").
+  virtual const std::vector<Vec<D>>* contact_impulse() = 0;
   /// The velocity conditions of this step, from the collected node masses.
   virtual void prepare_conditions(double dt) = 0;
   /// Eq. 25-26: v+ = v + a dt with the velocity conditions (half the first acceleration, Sec. 4.7).
