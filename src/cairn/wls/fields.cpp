@@ -89,8 +89,10 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
       scratch_.velocity[i] = nodes.velocity[s];
       scratch_.velocity_new[i] = nodes.velocity_new[s];
     });
-    if (impulse) scratch_impulse_.assign(impulse->begin() + static_cast<std::ptrdiff_t>(off),
-                                         impulse->begin() + static_cast<std::ptrdiff_t>(off + static_cast<std::size_t>(nn)));
+    if (impulse) {
+      const auto first = impulse->begin() + static_cast<std::ptrdiff_t>(off);
+      scratch_impulse_.assign(first, first + nn);
+    }
     Particles<D>& sub = particles_[static_cast<std::size_t>(f)];
     Integrator<D>& wls = integrator(f);
     wls.restore_energy_budget(0.0, 0.0);

@@ -53,11 +53,13 @@ void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid
   const Options& o = fields.integrator(0).options();
   const std::int32_t nn = grid.n_nodes();
   if (o.filter_acceleration) {
-    fields.for_each_field(nodes, nn, true, [&](Integrator<D>& wls, NodeField<D>& f) { wls.filter_acceleration(grid, f); });
+    fields.for_each_field(nodes, nn, true,
+                          [&](Integrator<D>& wls, NodeField<D>& f) { wls.filter_acceleration(grid, f); });
     engine.impose_end_conditions();
   }
   if (o.hourglass_damping > 0.0) {
-    fields.for_each_field(nodes, nn, true, [&](Integrator<D>& wls, NodeField<D>& f) { wls.damp_hourglass(grid, f); });
+    fields.for_each_field(nodes, nn, true,
+                          [&](Integrator<D>& wls, NodeField<D>& f) { wls.damp_hourglass(grid, f); });
     engine.impose_end_conditions();
   }
   if (o.xpic_order > 0)  // particle_velocity = "xpic": each field's particles' start
