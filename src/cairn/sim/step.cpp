@@ -134,7 +134,7 @@ class Simulation<D>::WlsStages final : public wls::EngineStages<D> {
     return sim_.body_force_.empty() ? nullptr : &sim_.body_acceleration_;
   }
   std::vector<Vec<D>>* node_body_forces() override { return &sim_.node_body_force_; }
-  bool surface_loads(double dt, const std::vector<wls::SurfaceLoads<D>*>& loads) override {
+  bool surface_loads(double dt, std::span<wls::SurfaceLoads<D>* const> loads) override {
     if (sim_.tractions_.empty()) return false;
     // The tractions' faces convected by F (bc/traction.hpp); the integrator spreads their forces
     // over the cut-cell surface (wls/integrator.cpp, spread_surface_loads). With one SurfaceLoads

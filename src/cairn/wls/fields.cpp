@@ -14,6 +14,7 @@ Fields<D>::Fields(const Grid<D>& grid, const Options& options, int n_fields, Int
     owned_.push_back(std::make_unique<Integrator<D>>(grid, options));
     integrators_.push_back(owned_.back().get());
   }
+  for (Integrator<D>* wls : integrators_) loads_.push_back(&wls->surface_loads());
   particles_.resize(static_cast<std::size_t>(n_fields));
   index_.resize(static_cast<std::size_t>(n_fields));
   body_.resize(static_cast<std::size_t>(n_fields));
@@ -82,15 +83,9 @@ void Fields<D>::move_particles(const Grid<D>& grid, const NodeField<D>& nodes, P
   gradient_.resize(particles.n());
   double grid_work = 0.0, transfer_energy = 0.0;  // this step's (method.energy_budget)
   for (int f = 0; f < n(); ++f) {
-    const auto off = static_cast<std::size_t>(f) * static_cast<std::size_t>(nn);
-    for_each_node(nn, [&](std::int32_t i) {
-      const std::size_t s = off + static_cast<std::size_t>(i);
-      scratch_.mass[i] = nodes.mass[s];
-      scratch_.velocity[i] = nodes.velocity[s];
-      scratch_.velocity_new[i] = nodes.velocity_new[s];
-    });
+    load_slots(nodes, f, nn);
     if (impulse) {
-      const auto first = impulse->begin() + static_cast<std::ptrdiff_t>(off);
+      const auto first = impulse->begin() + static_cast<std::ptrdiff_t>(f) * nn;
       scratch_impulse_.assign(first, first + nn);
     }
     Particles<D>& sub = particles_[static_cast<std::size_t>(f)];

@@ -11,6 +11,7 @@
 // arrays per step; contact runs are small next to that.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -62,17 +63,16 @@ class Fields {
   template <class Fn>
   void for_each_field(NodeField<D>& nodes, std::int32_t n_nodes, bool write, Fn&& fn) {
     for (int f = 0; f < n(); ++f) {
-      const auto off = static_cast<std::size_t>(f) * static_cast<std::size_t>(n_nodes);
-      for (std::int32_t i = 0; i < n_nodes; ++i) {
-        scratch_.mass[i] = nodes.mass[off + i];
-        scratch_.velocity[i] = nodes.velocity[off + i];
-        scratch_.velocity_new[i] = nodes.velocity_new[off + i];
-      }
+      load_slots(nodes, f, n_nodes);
       fn(integrator(f), scratch_);
-      if (write)
-        for (std::int32_t i = 0; i < n_nodes; ++i) nodes.velocity_new[off + i] = scratch_.velocity_new[i];
+      if (write) {
+        const auto off = static_cast<std::size_t>(f) * static_cast<std::size_t>(n_nodes);
+        std::copy(scratch_.velocity_new.begin(), scratch_.velocity_new.end(), nodes.velocity_new.begin() + off);
+      }
     }
   }
+  /// Every field's Integrator::surface_loads(), in field order (for EngineStages::surface_loads).
+  [[nodiscard]] const std::vector<SurfaceLoads<D>*>& surface_loads() const { return loads_; }
   /// The energy budget's sums (Integrator::grid_work, transfer_energy) over the fields and the
   /// steps: each step adds every field's sums of that step, so that the totals are the only
   /// state and a restart continues them bit for bit.
@@ -89,8 +89,17 @@ class Fields {
   }
 
  private:
+  /// Field f's slots of nodes.mass, velocity and velocity_new into scratch_.
+  void load_slots(const NodeField<D>& nodes, int f, std::int32_t n_nodes) {
+    const auto off = static_cast<std::ptrdiff_t>(f) * n_nodes;
+    std::copy_n(nodes.mass.begin() + off, n_nodes, scratch_.mass.begin());
+    std::copy_n(nodes.velocity.begin() + off, n_nodes, scratch_.velocity.begin());
+    std::copy_n(nodes.velocity_new.begin() + off, n_nodes, scratch_.velocity_new.begin());
+  }
+
   std::vector<std::unique_ptr<Integrator<D>>> owned_;  ///< the integrators of fields 1..n-1
   std::vector<Integrator<D>*> integrators_;
+  std::vector<SurfaceLoads<D>*> loads_;                 ///< surface_loads()
   std::vector<Particles<D>> particles_;                 ///< per field: a copy of its particles
   std::vector<std::vector<std::int32_t>> index_;        ///< per field: their indices in the whole set
   std::vector<std::vector<Vec<D>>> body_;               ///< per field: their body accelerations

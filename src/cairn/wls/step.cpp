@@ -9,7 +9,8 @@ void step(Integrator<D>& wls, EngineStages<D>& engine, const Grid<D>& grid, Part
   engine.lap(0);
   // Sec. 4.1-4.5: node mass, least-squares velocity (as m v) and forces.
   const std::vector<Vec<D>>* body = engine.body_accelerations();
-  const bool loads = engine.surface_loads(dt, {&wls.surface_loads()});  // tractions at t + dt/2
+  SurfaceLoads<D>* const one = &wls.surface_loads();
+  const bool loads = engine.surface_loads(dt, {&one, 1});  // tractions at t + dt/2
   wls.collect(grid, particles, density0, body, nodes, body ? engine.node_body_forces() : nullptr, loads);
   engine.prepare_conditions(dt);
   engine.lap(1);
@@ -41,9 +42,7 @@ void step_fields(Fields<D>& fields, EngineStages<D>& engine, const Grid<D>& grid
   const std::vector<Vec<D>>* body = engine.body_accelerations();
   fields.split(particles, field_offset, grid.n_nodes(), body);
   engine.lap(0);
-  std::vector<SurfaceLoads<D>*> loads;  // tractions at t + dt/2, each field's on its own faces
-  for (int f = 0; f < fields.n(); ++f) loads.push_back(&fields.integrator(f).surface_loads());
-  const bool loaded = engine.surface_loads(dt, loads);
+  const bool loaded = engine.surface_loads(dt, fields.surface_loads());  // each field's own faces
   fields.collect(grid, density0, body != nullptr, nodes, body ? engine.node_body_forces() : nullptr, loaded);
   engine.prepare_contact(dt);  // seed 004: contact nodes, normals, first correction
   engine.prepare_conditions(dt);

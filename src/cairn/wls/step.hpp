@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "cairn/grid/grid.hpp"
@@ -26,7 +27,7 @@ class EngineStages {
   virtual std::vector<Vec<D>>* node_body_forces() = 0;
   /// Fill `loads` with the surface loads (tractions) at t + dt/2: one SurfaceLoads for all
   /// particles, or (step_fields) one per contact field, each with its field's faces; false: none.
-  virtual bool surface_loads(double dt, const std::vector<SurfaceLoads<D>*>& loads) = 0;
+  virtual bool surface_loads(double dt, std::span<SurfaceLoads<D>* const> loads) = 0;
   /// Multimaterial mode (step_fields): the contact nodes, normals and separations of this step
   /// from the collected fields and the first correction of their momenta (seed 004 Eq. 26);
   /// the second one comes with update_grid (Eq. 30-34).
